@@ -1,0 +1,138 @@
+//! Opening a volume file of either format, listing its grids, reading one.
+
+use crate::error::{Error, ErrorKind, Result};
+use crate::grid::{Grid, GridInfo};
+use crate::metadata::MetaMap;
+use crate::nanovdb::{self, NanoIndex};
+use crate::openvdb::{self, Archive};
+use crate::source::FileSource;
+use std::path::Path;
+
+/// Which of the two formats a file is in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    OpenVdb,
+    NanoVdb,
+}
+
+impl Format {
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::OpenVdb => "vdb",
+            Format::NanoVdb => "nvdb",
+        }
+    }
+}
+
+enum Index {
+    OpenVdb(Archive),
+    NanoVdb(NanoIndex),
+}
+
+/// An open volume file: its grid list is read, its grid data is not.
+pub struct VolumeFile {
+    source: FileSource,
+    index: Index,
+}
+
+impl VolumeFile {
+    /// Opens a file and reads its header and grid index (never grid data).
+    /// The format is told by the magic bytes, not the extension.
+    pub fn open(path: impl AsRef<Path>) -> Result<VolumeFile> {
+        let path = path.as_ref();
+        let err = |kind: ErrorKind| Error::new(path, kind);
+        let source = FileSource::open(path).map_err(|e| err(e.into()))?;
+        let magic = source.read_window(0, 8, "magic").map_err(err)?;
+        let index = if magic == openvdb::MAGIC {
+            Index::OpenVdb(Archive::open(&source).map_err(err)?)
+        } else if nanovdb::MAGICS.iter().any(|m| magic == m.as_slice()) {
+            Index::NanoVdb(NanoIndex::open(&source).map_err(err)?)
+        } else if magic.len() < 8 {
+            return Err(err(ErrorKind::Truncated {
+                what: "magic",
+                offset: 0,
+                needed: 8,
+                available: magic.len() as u64,
+            }));
+        } else {
+            return Err(err(ErrorKind::BadMagic(magic)));
+        };
+        Ok(VolumeFile { source, index })
+    }
+
+    pub fn path(&self) -> &Path {
+        self.source.path()
+    }
+
+    pub fn format(&self) -> Format {
+        match self.index {
+            Index::OpenVdb(_) => Format::OpenVdb,
+            Index::NanoVdb(_) => Format::NanoVdb,
+        }
+    }
+
+    /// The grids in file order.
+    pub fn grids(&self) -> Vec<&GridInfo> {
+        match &self.index {
+            Index::OpenVdb(a) => a.grids.iter().map(|g| &g.info).collect(),
+            Index::NanoVdb(n) => n.grids.iter().collect(),
+        }
+    }
+
+    /// File-level metadata (OpenVDB only; empty for NanoVDB).
+    pub fn metadata(&self) -> &MetaMap {
+        static EMPTY: MetaMap = Vec::new();
+        match &self.index {
+            Index::OpenVdb(a) => &a.metadata,
+            Index::NanoVdb(_) => &EMPTY,
+        }
+    }
+
+    /// The OpenVDB file format version, or `None` for NanoVDB.
+    pub fn file_version(&self) -> Option<u32> {
+        match &self.index {
+            Index::OpenVdb(a) => Some(a.file_version),
+            Index::NanoVdb(_) => None,
+        }
+    }
+
+    /// Bytes read from disk since the file was opened.
+    pub fn bytes_read(&self) -> u64 {
+        self.source.bytes_read()
+    }
+
+    pub fn file_len(&self) -> u64 {
+        self.source.len()
+    }
+
+    /// Reads grid `index` (file order).
+    pub fn read_grid(&self, index: usize) -> Result<Grid> {
+        let err = |kind: ErrorKind| Error::new(self.path(), kind);
+        let count = self.grids().len();
+        if index >= count {
+            return Err(err(ErrorKind::NoSuchGrid(format!(
+                "#{index} (the file has {count})"
+            ))));
+        }
+        match &self.index {
+            Index::OpenVdb(a) => a.read_grid(&self.source, index),
+            Index::NanoVdb(n) => n.read_grid(&self.source, index),
+        }
+        .map_err(err)
+    }
+
+    /// Index of the first grid called `name`; the unique stored name
+    /// (`density\x1e1`) picks a later duplicate.
+    pub fn find_grid(&self, name: &str) -> Result<usize> {
+        let grids = self.grids();
+        grids
+            .iter()
+            .position(|g| g.unique_name == name)
+            .or_else(|| grids.iter().position(|g| g.name == name))
+            .ok_or_else(|| Error::new(self.path(), ErrorKind::NoSuchGrid(name.to_string())))
+    }
+
+    pub fn read_grid_by_name(&self, name: &str) -> Result<Grid> {
+        self.read_grid(self.find_grid(name)?)
+    }
+}
