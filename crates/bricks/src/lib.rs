@@ -1,1 +1,43 @@
-//! placeholder
+//! Sparse bricks of density with a hierarchy of majorants and minorants:
+//! what the renderer's trackers walk.
+//!
+//! The pipeline: [`convert`] turns a float grid's tree (from `cirrus-vdb`)
+//! into a [`BrickVolume`]: a dense map of 8^3 bricks (`layout.rs`: empty,
+//! constant, or stored at f32, f16 or u8), a voxel atlas, and a pyramid of
+//! (min, max) bounds per brick and per coarser cell (`bounds.rs`) that bound
+//! the trilinearly interpolated density. [`SegmentIter`] (`dda.rs`) walks a
+//! ray through the pyramid front to back, skipping empty space at the
+//! coarsest level and yielding [`RaySegment`]s with tight bounds;
+//! [`BrickVolume::trilinear`] is the density lookup. `format.rs` writes and
+//! memory-maps the `.cbrk` file of a converted volume, and `baseline.rs`
+//! builds the coarser majorant structures the benchmarks compare against.
+
+mod bounds;
+mod convert;
+mod dda;
+mod layout;
+mod section;
+mod volume;
+
+pub use bounds::{BoundsLevel, MAX_LEVELS};
+pub use convert::{convert, convert_tree, MAX_MAP_BRICKS};
+pub use dda::{ray_box, RaySegment, SegmentIter};
+pub use layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS};
+pub use section::Section;
+pub use volume::{Atlas, BrickVolume, SourceInfo};
+
+/// Why a conversion or a `.cbrk` load failed.
+#[derive(Debug, thiserror::Error)]
+pub enum BrickError {
+    #[error("unsupported: {0}")]
+    Unsupported(String),
+    #[error("too large: {0}")]
+    TooLarge(String),
+    #[error("{path}: {msg}")]
+    File {
+        path: std::path::PathBuf,
+        msg: String,
+    },
+    #[error(transparent)]
+    Vdb(#[from] cirrus_vdb::Error),
+}

@@ -1,0 +1,117 @@
+//! The majorant/minorant hierarchy: per brick, then per 2^3 block of the
+//! level below, a (min, max) pair that bounds the trilinearly interpolated
+//! density anywhere inside the cell.
+//!
+//! Level 0 cells are bricks (8 voxels a side); level `k` cells are
+//! `8 << k` voxels a side. A brick's bounds are taken over the voxels
+//! `[o, o + 8]` per axis: trilinear interpolation at any point of
+//! `[o, o + 8)` reads exactly those (its corner voxels are `floor(p)` and
+//! `floor(p) + 1`), and is a convex combination of them, so it can neither
+//! exceed their max nor fall below their min. Coarser cells take the max of
+//! their children's maxima and the min of their minima (a child outside the
+//! grid counts as (0, 0): the density there is zero). The pyramid stops at a
+//! single cell or at [`MAX_LEVELS`].
+//!
+//! Stored as f32 pairs, 8 bytes a cell; the whole pyramid is about
+//! 8/7 x 8 bytes per brick.
+
+use crate::section::Section;
+
+/// Most levels: level 7 cells are 1024 voxels wide.
+pub const MAX_LEVELS: usize = 8;
+
+/// One level of the pyramid: a dense grid of (min, max) pairs.
+#[derive(Clone, Debug)]
+pub struct BoundsLevel {
+    /// Cells per axis.
+    pub dims: [u32; 3],
+    /// `2 * dims.x * dims.y * dims.z` floats: min then max, x-major.
+    pub cells: Section<f32>,
+}
+
+impl BoundsLevel {
+    #[inline]
+    pub fn index(&self, c: [u32; 3]) -> usize {
+        ((c[0] as usize * self.dims[1] as usize) + c[1] as usize) * self.dims[2] as usize
+            + c[2] as usize
+    }
+
+    /// (min, max) of a cell; cells outside the level are (0, 0).
+    #[inline]
+    pub fn get(&self, c: [i32; 3]) -> (f32, f32) {
+        if c.iter()
+            .zip(self.dims)
+            .any(|(&v, d)| v < 0 || v as u32 >= d)
+        {
+            return (0.0, 0.0);
+        }
+        let i = 2 * self.index([c[0] as u32, c[1] as u32, c[2] as u32]);
+        (self.cells[i], self.cells[i + 1])
+    }
+
+    pub fn cell_count(&self) -> usize {
+        self.dims.iter().map(|&d| d as usize).product()
+    }
+
+    pub fn bytes(&self) -> usize {
+        self.cells.len() * 4
+    }
+}
+
+/// Builds the coarser levels above `level0`.
+pub fn build_pyramid(level0: BoundsLevel) -> Vec<BoundsLevel> {
+    let mut levels = vec![level0];
+    while levels.len() < MAX_LEVELS {
+        let below = levels.last().unwrap();
+        if below.dims.iter().all(|&d| d <= 1) {
+            break;
+        }
+        let dims = below.dims.map(|d| d.div_ceil(2));
+        let mut cells = vec![0f32; 2 * dims.iter().map(|&d| d as usize).product::<usize>()];
+        for x in 0..dims[0] as i32 {
+            for y in 0..dims[1] as i32 {
+                for z in 0..dims[2] as i32 {
+                    let (mut lo, mut hi) = (f32::INFINITY, 0f32);
+                    for k in 0..8 {
+                        let c = [2 * x + (k >> 2), 2 * y + ((k >> 1) & 1), 2 * z + (k & 1)];
+                        let (a, b) = below.get(c);
+                        lo = lo.min(a);
+                        hi = hi.max(b);
+                    }
+                    let i = 2
+                        * ((x as usize * dims[1] as usize + y as usize) * dims[2] as usize
+                            + z as usize);
+                    cells[i] = lo;
+                    cells[i + 1] = hi;
+                }
+            }
+        }
+        levels.push(BoundsLevel {
+            dims,
+            cells: cells.into(),
+        });
+    }
+    levels
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coarse_cells_bound_their_children_and_count_outside_as_zero() {
+        // 3 x 1 x 1 bricks: (1, 2), (0.5, 4), (3, 3).
+        let level0 = BoundsLevel {
+            dims: [3, 1, 1],
+            cells: vec![1.0, 2.0, 0.5, 4.0, 3.0, 3.0].into(),
+        };
+        let levels = build_pyramid(level0);
+        assert_eq!(levels.len(), 3);
+        assert_eq!(levels[1].dims, [2, 1, 1]);
+        // Cell 0 covers bricks 0,1 and four outside-y/z children: min 0.
+        assert_eq!(levels[1].get([0, 0, 0]), (0.0, 4.0));
+        assert_eq!(levels[1].get([1, 0, 0]), (0.0, 3.0));
+        assert_eq!(levels[2].get([0, 0, 0]), (0.0, 4.0));
+        assert_eq!(levels[2].get([1, 0, 0]), (0.0, 0.0));
+    }
+}

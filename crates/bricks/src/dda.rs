@@ -1,0 +1,148 @@
+//! Front-to-back majorant segments along a ray, from the bounds pyramid.
+//!
+//! At each step the walk finds the cell that contains the ray just past the
+//! current `t`, then looks at the pyramid from the coarsest level down:
+//! - an empty cell (max 0) is skipped whole, at the coarsest level that is
+//!   empty, so empty space costs a step per coarse cell;
+//! - a uniform cell (min == max: a tile, a constant region) is one segment
+//!   at whatever level it is uniform;
+//! - otherwise the brick is one segment with the brick's (min, max).
+//!
+//! Neighbouring segments with the same bounds merge into one. The ray is
+//! given in local index coordinates of the volume (`BrickVolume::local_from_world`
+//! applied to a world ray): an affine map keeps the ray parameter, so `t`
+//! stays the caller's (world) distance along its direction.
+//!
+//! Robustness: the cell is located at `t + nudge` (a relative and an
+//! absolute epsilon along the ray) so a point on a cell face is placed in the
+//! cell being entered, and every step advances `t` by at least the nudge,
+//! so the walk ends after at most (length / nudge) steps whatever the
+//! rounding: no infinite loop for rays along faces, edges or corners.
+
+use crate::layout::BRICK_LOG2;
+use crate::volume::BrickVolume;
+use glam::Vec3;
+
+/// Over `[t0, t1]` the density lies within `[minorant, majorant]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RaySegment {
+    pub t0: f32,
+    pub t1: f32,
+    pub minorant: f32,
+    pub majorant: f32,
+}
+
+/// Iterator of [`RaySegment`]s; see the module doc.
+pub struct SegmentIter<'a> {
+    volume: &'a BrickVolume,
+    origin: Vec3,
+    dir: Vec3,
+    inv_dir: Vec3,
+    t: f32,
+    t_end: f32,
+    pending: Option<RaySegment>,
+    /// Pyramid steps taken (cells visited), for statistics.
+    pub steps: u32,
+}
+
+/// Slab test of a ray against the box [lo, hi]: the parameter interval inside.
+pub fn ray_box(origin: Vec3, inv_dir: Vec3, lo: Vec3, hi: Vec3) -> (f32, f32) {
+    let a = (lo - origin) * inv_dir;
+    let b = (hi - origin) * inv_dir;
+    // NaN (0 * inf for a ray on a slab face) is dropped by min/max.
+    let t0 = a.min(b).max_element();
+    let t1 = a.max(b).min_element();
+    (t0, t1)
+}
+
+impl<'a> SegmentIter<'a> {
+    pub fn new(volume: &'a BrickVolume, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
+        let inv_dir = dir.recip();
+        let (b0, b1) = ray_box(origin, inv_dir, Vec3::ZERO, volume.local_extent());
+        let valid = origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO;
+        let (t, t_end) = if valid {
+            (t_min.max(b0), t_max.min(b1))
+        } else {
+            (0.0, 0.0)
+        };
+        SegmentIter {
+            volume,
+            origin,
+            dir,
+            inv_dir,
+            t,
+            t_end,
+            pending: None,
+            steps: 0,
+        }
+    }
+
+    /// The next raw (unmerged) segment, or `None` at the end of the ray.
+    fn step(&mut self) -> Option<RaySegment> {
+        let levels = &self.volume.levels;
+        while self.t < self.t_end {
+            self.steps += 1;
+            let nudge = self.t.abs() * 1e-6 + 1e-5 / self.dir.abs().max_element();
+            let p = self.origin + self.dir * (self.t + nudge);
+            let voxel = p.floor().as_ivec3();
+            // From the coarsest level down to the first non-empty, non-uniform.
+            let mut emit = None;
+            let mut exit_level = 0;
+            for (l, level) in levels.iter().enumerate().rev() {
+                let cell = voxel >> (BRICK_LOG2 + l as u32) as i32;
+                let (lo, hi) = level.get(cell.to_array());
+                if hi <= 0.0 || lo == hi || l == 0 {
+                    exit_level = l;
+                    if hi > 0.0 {
+                        emit = Some((lo, hi));
+                    }
+                    break;
+                }
+            }
+            let size = (1i32 << (BRICK_LOG2 + exit_level as u32)) as f32;
+            let cell_lo = (voxel >> (BRICK_LOG2 + exit_level as u32) as i32).as_vec3() * size;
+            let (_, exit) = ray_box(self.origin, self.inv_dir, cell_lo, cell_lo + size);
+            let t0 = self.t;
+            let t1 = exit.max(t0 + nudge).min(self.t_end);
+            self.t = t1;
+            if let Some((minorant, majorant)) = emit {
+                return Some(RaySegment {
+                    t0,
+                    t1,
+                    minorant,
+                    majorant,
+                });
+            }
+        }
+        None
+    }
+}
+
+impl Iterator for SegmentIter<'_> {
+    type Item = RaySegment;
+
+    fn next(&mut self) -> Option<RaySegment> {
+        loop {
+            match (self.step(), self.pending) {
+                (None, _) => return self.pending.take(),
+                (Some(s), None) => self.pending = Some(s),
+                (Some(s), Some(p)) => {
+                    if p.t1 == s.t0 && p.majorant == s.majorant && p.minorant == s.minorant {
+                        self.pending = Some(RaySegment { t1: s.t1, ..p });
+                    } else {
+                        self.pending = Some(s);
+                        return Some(p);
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl BrickVolume {
+    /// Majorant segments of the ray `origin + t * dir` (local index
+    /// coordinates) within `[t_min, t_max]`.
+    pub fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> SegmentIter<'_> {
+        SegmentIter::new(self, origin, dir, t_min, t_max)
+    }
+}

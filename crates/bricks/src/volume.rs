@@ -1,0 +1,196 @@
+//! A converted volume: the brick map, voxel atlas, bounds pyramid and the
+//! transform, with the density lookups the renderer calls.
+
+use crate::bounds::BoundsLevel;
+use crate::layout::{voxel_offset, BrickRef, Precision, BRICK_LOG2};
+use crate::section::Section;
+use glam::{DMat4, IVec3, Vec3};
+
+/// Voxel storage of the stored bricks, at their precision.
+#[derive(Clone, Debug)]
+pub enum Atlas {
+    F32(Section<f32>),
+    F16(Section<u16>),
+    /// With a (lo, step) pair per brick in `BrickVolume::ranges`.
+    U8(Section<u8>),
+}
+
+impl Atlas {
+    pub fn precision(&self) -> Precision {
+        match self {
+            Atlas::F32(_) => Precision::F32,
+            Atlas::F16(_) => Precision::F16,
+            Atlas::U8(_) => Precision::U8,
+        }
+    }
+    pub fn bytes(&self) -> usize {
+        match self {
+            Atlas::F32(s) => s.len() * 4,
+            Atlas::F16(s) => s.len() * 2,
+            Atlas::U8(s) => s.len(),
+        }
+    }
+}
+
+/// Where the volume came from and what converting it did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SourceInfo {
+    pub grid_name: String,
+    /// Active voxels of the source grid, tiles included.
+    pub active_voxels: u64,
+    pub bricks_stored: u64,
+    pub bricks_constant: u64,
+    /// Bricks of the map that hold nothing.
+    pub bricks_empty: u64,
+    /// Largest |stored - source| over all voxels.
+    pub max_error: f32,
+    /// Voxels whose value was NaN, infinite or negative, stored as 0.
+    pub sanitized_voxels: u64,
+}
+
+/// A density volume in 8^3 bricks with its bounds hierarchy.
+#[derive(Clone, Debug)]
+pub struct BrickVolume {
+    /// Index coordinate of the first voxel of brick (0, 0, 0).
+    pub origin: IVec3,
+    /// Bricks per axis.
+    pub dims: [u32; 3],
+    /// Source grid's index-to-world matrix.
+    pub index_to_world: DMat4,
+    pub(crate) map: Section<u32>,
+    pub(crate) constants: Section<f32>,
+    /// Per stored brick (lo, step) for u8 bricks; empty otherwise.
+    pub(crate) ranges: Section<f32>,
+    pub(crate) atlas: Atlas,
+    /// Level 0 = bricks; each next level halves the resolution.
+    pub levels: Vec<BoundsLevel>,
+    pub info: SourceInfo,
+}
+
+impl BrickVolume {
+    pub fn precision(&self) -> Precision {
+        self.atlas.precision()
+    }
+
+    /// Bytes of each part: (map, constants + ranges, atlas, bounds per level).
+    pub fn memory_bytes(&self) -> (usize, usize, usize, Vec<usize>) {
+        (
+            self.map.len() * 4,
+            (self.constants.len() + self.ranges.len()) * 4,
+            self.atlas.bytes(),
+            self.levels.iter().map(|l| l.bytes()).collect(),
+        )
+    }
+
+    pub fn total_bytes(&self) -> usize {
+        let (a, b, c, d) = self.memory_bytes();
+        a + b + c + d.iter().sum::<usize>()
+    }
+
+    /// Extent of the brick grid in local index coordinates: [0, dims * 8).
+    pub fn local_extent(&self) -> Vec3 {
+        Vec3::new(
+            self.dims[0] as f32,
+            self.dims[1] as f32,
+            self.dims[2] as f32,
+        ) * (1 << BRICK_LOG2) as f32
+    }
+
+    /// Maps world coordinates to local index coordinates (index minus `origin`).
+    pub fn local_from_world(&self) -> DMat4 {
+        DMat4::from_translation(-self.origin.as_dvec3()) * self.index_to_world.inverse()
+    }
+
+    #[inline]
+    pub(crate) fn brick_ref(&self, b: IVec3) -> BrickRef {
+        if b.x < 0
+            || b.y < 0
+            || b.z < 0
+            || b.x as u32 >= self.dims[0]
+            || b.y as u32 >= self.dims[1]
+            || b.z as u32 >= self.dims[2]
+        {
+            return BrickRef::Empty;
+        }
+        let i = (b.x as usize * self.dims[1] as usize + b.y as usize) * self.dims[2] as usize
+            + b.z as usize;
+        BrickRef::decode(self.map[i])
+    }
+
+    /// Value of voxel `n` of stored brick `b`.
+    #[inline]
+    fn stored(&self, b: u32, n: usize) -> f32 {
+        let i = b as usize * 512 + n;
+        match &self.atlas {
+            Atlas::F32(a) => a[i],
+            Atlas::F16(a) => half::f16::from_bits(a[i]).to_f32(),
+            Atlas::U8(a) => {
+                let (lo, step) = (self.ranges[2 * b as usize], self.ranges[2 * b as usize + 1]);
+                lo + a[i] as f32 * step
+            }
+        }
+    }
+
+    /// The voxel at local index `c` (0 outside the volume).
+    #[inline]
+    pub fn voxel(&self, c: IVec3) -> f32 {
+        match self.brick_ref(c >> BRICK_LOG2 as i32) {
+            BrickRef::Empty => 0.0,
+            BrickRef::Constant(k) => self.constants[k as usize],
+            BrickRef::Stored(b) => self.stored(b, voxel_offset(c.x, c.y, c.z)),
+        }
+    }
+
+    /// Nearest-voxel density at a local index point.
+    #[inline]
+    pub fn nearest(&self, p: Vec3) -> f32 {
+        self.voxel((p + 0.5).floor().as_ivec3())
+    }
+
+    /// Trilinear density at a local index point (voxel centres at integer
+    /// coordinates, as OpenVDB's `BoxSampler`). Reads one brick when all
+    /// eight corners share it (7/8 of positions per axis), else each corner.
+    #[inline]
+    pub fn trilinear(&self, p: Vec3) -> f32 {
+        if !p.is_finite() {
+            return 0.0;
+        }
+        let f0 = p.floor();
+        let c = f0.as_ivec3();
+        let f = p - f0;
+        let v = if (c & 7).cmplt(IVec3::splat(7)).all() {
+            match self.brick_ref(c >> BRICK_LOG2 as i32) {
+                BrickRef::Empty => return 0.0,
+                BrickRef::Constant(k) => return self.constants[k as usize],
+                BrickRef::Stored(b) => {
+                    let n = voxel_offset(c.x, c.y, c.z);
+                    [0, 1, 8, 9, 64, 65, 72, 73].map(|d| self.stored(b, n + d))
+                }
+            }
+        } else {
+            let at = |dx, dy, dz| self.voxel(c + IVec3::new(dx, dy, dz));
+            [
+                at(0, 0, 0),
+                at(0, 0, 1),
+                at(0, 1, 0),
+                at(0, 1, 1),
+                at(1, 0, 0),
+                at(1, 0, 1),
+                at(1, 1, 0),
+                at(1, 1, 1),
+            ]
+        };
+        // Corners ordered x-major: v[4x + 2y + z].
+        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+        let x0 = lerp(lerp(v[0], v[1], f.z), lerp(v[2], v[3], f.z), f.y);
+        let x1 = lerp(lerp(v[4], v[5], f.z), lerp(v[6], v[7], f.z), f.y);
+        lerp(x0, x1, f.x)
+    }
+
+    /// Largest value of the volume (the global majorant).
+    pub fn max_density(&self) -> f32 {
+        self.levels.last().map_or(0.0, |l| {
+            l.cells.chunks_exact(2).fold(0.0, |m, c| m.max(c[1]))
+        })
+    }
+}

@@ -1,0 +1,245 @@
+//! Property tests of conversion, lookups and the majorant walk against the
+//! reader's own tree (the independent reference).
+
+use cirrus_bricks::{convert_tree, BrickVolume, Precision, RaySegment};
+use cirrus_vdb::{Coord, Tree};
+use glam::{IVec3, Vec3};
+use proptest::prelude::*;
+
+/// A tree with a few random blobs of density, some isolated voxels, some
+/// special values, and an 8^3-aligned constant region.
+fn random_tree(seed: u64, origin: IVec3) -> Tree<f32> {
+    let mut rng = seed;
+    let mut next = move || {
+        rng = rng
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((rng >> 33) as f32) / (1u64 << 31) as f32
+    };
+    let mut tree = Tree::new(0.0f32);
+    for _ in 0..3 {
+        let c = Vec3::new(next(), next(), next()) * 40.0;
+        let r = 3.0 + next() * 8.0;
+        let ri = r.ceil() as i32;
+        for x in -ri..=ri {
+            for y in -ri..=ri {
+                for z in -ri..=ri {
+                    let p = c + Vec3::new(x as f32, y as f32, z as f32);
+                    let d = 1.0 - (p - c).length() / r;
+                    if d > 0.0 {
+                        let ijk = origin + p.floor().as_ivec3();
+                        tree.set_value_on(Coord::new(ijk.x, ijk.y, ijk.z), d * (0.5 + next()));
+                    }
+                }
+            }
+        }
+    }
+    for _ in 0..20 {
+        let ijk = origin + (Vec3::new(next(), next(), next()) * 60.0).as_ivec3();
+        tree.set_value_on(Coord::new(ijk.x, ijk.y, ijk.z), next() * 3.0);
+    }
+    // A constant 8^3 block: becomes a constant brick.
+    for x in 48..56 {
+        for y in 0..8 {
+            for z in 0..8 {
+                tree.set_value_on(Coord::new(origin.x + x, origin.y + y, origin.z + z), 0.75);
+            }
+        }
+    }
+    tree
+}
+
+/// The reference density: trilinear over the tree's active values (inactive
+/// = background 0), with the same arithmetic as the bricks.
+fn reference_trilinear(tree: &Tree<f32>, p: Vec3) -> f32 {
+    let f0 = p.floor();
+    let c = f0.as_ivec3();
+    let f = p - f0;
+    let mut acc = tree.accessor();
+    let mut at = |dx: i32, dy: i32, dz: i32| {
+        let (v, on) = acc.probe(Coord::new(c.x + dx, c.y + dy, c.z + dz));
+        if on {
+            v
+        } else {
+            0.0
+        }
+    };
+    let v = [
+        at(0, 0, 0),
+        at(0, 0, 1),
+        at(0, 1, 0),
+        at(0, 1, 1),
+        at(1, 0, 0),
+        at(1, 0, 1),
+        at(1, 1, 0),
+        at(1, 1, 1),
+    ];
+    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+    let x0 = lerp(lerp(v[0], v[1], f.z), lerp(v[2], v[3], f.z), f.y);
+    let x1 = lerp(lerp(v[4], v[5], f.z), lerp(v[6], v[7], f.z), f.y);
+    lerp(x0, x1, f.x)
+}
+
+fn local(vol: &BrickVolume, p: Vec3) -> Vec3 {
+    p - vol.origin.as_vec3()
+}
+
+fn check_ray(
+    vol: &BrickVolume,
+    tree: &Tree<f32>,
+    o: Vec3,
+    d: Vec3,
+    t_min: f32,
+    t_max: f32,
+    samples: &[f32],
+) {
+    let lo = local(vol, o);
+    let segs: Vec<RaySegment> = vol.segments(lo, d, t_min, t_max).collect();
+    for w in segs.windows(2) {
+        assert!(
+            w[0].t1 <= w[1].t0,
+            "segments overlap or are out of order: {w:?}"
+        );
+    }
+    for s in &segs {
+        assert!(
+            s.t0 >= t_min && s.t1 <= t_max && s.t0 < s.t1,
+            "segment {s:?} outside [{t_min}, {t_max}]"
+        );
+        assert!(s.minorant <= s.majorant);
+    }
+    for &u in samples {
+        let t = t_min + (t_max - t_min) * u;
+        let density = reference_trilinear(tree, o + d * t);
+        match segs.iter().find(|s| s.t0 < t && t < s.t1) {
+            Some(s) => assert!(
+                s.minorant <= density && density <= s.majorant,
+                "density {density} at t={t} outside [{}, {}] of {s:?}",
+                s.minorant,
+                s.majorant
+            ),
+            // Points on a segment end are covered by either neighbour: skip exact ends.
+            None if segs.iter().any(|s| s.t0 == t || s.t1 == t) => {}
+            None => assert_eq!(
+                density, 0.0,
+                "density {density} at t={t} lies in no segment"
+            ),
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn brick_lookups_equal_the_tree_exactly_at_f32(seed in 0u64..1000, px in -4f32..70.0, py in -4f32..70.0, pz in -4f32..70.0) {
+        let origin = IVec3::new(-13, 5, 200);
+        let tree = random_tree(seed, origin);
+        let vol = convert_tree(&tree, Precision::F32).unwrap();
+        for k in 0..64 {
+            // Points on a 1/64 lattice, so moving them to the volume's local frame is exact.
+            let q = Vec3::new(px, py, pz) + Vec3::new(k as f32 * 0.37, k as f32 * 0.11, -(k as f32) * 0.23);
+            let p = origin.as_vec3() + (q * 64.0).round() / 64.0;
+            prop_assert_eq!(vol.trilinear(local(&vol, p)), reference_trilinear(&tree, p));
+        }
+    }
+
+    #[test]
+    fn segments_bound_the_density_and_cover_it(
+        seed in 0u64..1000,
+        o in prop::array::uniform3(-20f32..80.0),
+        d in prop::array::uniform3(-1f32..1.0),
+        samples in prop::collection::vec(0f32..1.0, 64),
+    ) {
+        let tree = random_tree(seed, IVec3::ZERO);
+        let vol = convert_tree(&tree, Precision::F32).unwrap();
+        let d = Vec3::from(d);
+        prop_assume!(d.length() > 1e-3);
+        check_ray(&vol, &tree, Vec3::from(o), d, 0.0, 200.0, &samples);
+    }
+
+    #[test]
+    fn axis_rays_along_faces_edges_and_corners_terminate_and_bound(
+        seed in 0u64..200,
+        axis in 0usize..3,
+        sign in prop::bool::ANY,
+        a in 0i32..8, b in 0i32..8,
+        samples in prop::collection::vec(0f32..1.0, 64),
+    ) {
+        let tree = random_tree(seed, IVec3::ZERO);
+        let vol = convert_tree(&tree, Precision::F32).unwrap();
+        // Origins on brick faces, edges and corners (multiples of 8), and on voxel centres.
+        let mut o = [a as f32 * 8.0, b as f32 * 8.0, 0.0];
+        o.rotate_right(axis);
+        let mut d = Vec3::ZERO;
+        d[axis] = if sign { 1.0 } else { -1.0 };
+        let start = if sign { -10.0 } else { 90.0 };
+        let mut o = Vec3::from(o);
+        o[axis] = start;
+        check_ray(&vol, &tree, o, d, 0.0, 120.0, &samples);
+        check_ray(&vol, &tree, o + Vec3::splat(0.5), d, 0.0, 120.0, &samples);
+    }
+}
+
+#[test]
+fn quantised_bricks_stay_within_their_stated_error() {
+    let tree = random_tree(7, IVec3::ZERO);
+    let exact = convert_tree(&tree, Precision::F32).unwrap();
+    assert_eq!(exact.info.max_error, 0.0);
+    let h = convert_tree(&tree, Precision::F16).unwrap();
+    let q = convert_tree(&tree, Precision::U8).unwrap();
+    // f16 keeps 11 significant bits: relative error at most 2^-11 (values here are normal).
+    let vmax = 3.0f32 * 1.5;
+    assert!(
+        h.info.max_error <= vmax * 2f32.powi(-11),
+        "f16 error {}",
+        h.info.max_error
+    );
+    let mut worst_u8 = 0f32;
+    for x in -1..70 {
+        for y in -1..70 {
+            for z in -1..70 {
+                let c = IVec3::new(x, y, z);
+                let v = exact.voxel(c - exact.origin);
+                let eh = (h.voxel(c - h.origin) - v).abs();
+                assert!(eh <= v * 2f32.powi(-11) + 1e-30, "f16 voxel {c} error {eh}");
+                worst_u8 = worst_u8.max((q.voxel(c - q.origin) - v).abs());
+            }
+        }
+    }
+    // u8: half a step of the brick's range; the widest range here is below vmax.
+    assert!(
+        worst_u8 <= q.info.max_error + 1e-6 && q.info.max_error <= vmax / 510.0 * 1.001,
+        "u8 error {worst_u8} / {}",
+        q.info.max_error
+    );
+    assert!(
+        q.total_bytes() * 3 <= exact.total_bytes(),
+        "u8 bricks {} vs f32 {}",
+        q.total_bytes(),
+        exact.total_bytes()
+    );
+}
+
+#[test]
+fn conversion_counts_bricks_and_sanitises_bad_values() {
+    let mut tree = Tree::new(0.0f32);
+    tree.set_value_on(Coord::new(1, 1, 1), 1.0);
+    tree.set_value_on(Coord::new(2, 1, 1), f32::NAN);
+    tree.set_value_on(Coord::new(3, 1, 1), f32::INFINITY);
+    tree.set_value_on(Coord::new(4, 1, 1), -2.0);
+    for x in 16..24 {
+        for y in 0..8 {
+            for z in 0..8 {
+                tree.set_value_on(Coord::new(x, y, z), 0.5);
+            }
+        }
+    }
+    let vol = convert_tree(&tree, Precision::F32).unwrap();
+    assert_eq!(vol.info.sanitized_voxels, 3);
+    assert_eq!(vol.info.bricks_stored, 1);
+    assert_eq!(vol.info.bricks_constant, 1);
+    assert_eq!(vol.voxel(IVec3::new(2, 1, 1) - vol.origin), 0.0);
+    assert_eq!(vol.voxel(IVec3::new(1, 1, 1) - vol.origin), 1.0);
+    assert_eq!(vol.max_density(), 1.0 + 1.0 / (1 << 20) as f32);
+}
