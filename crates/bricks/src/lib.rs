@@ -15,6 +15,7 @@
 mod bounds;
 mod convert;
 mod dda;
+mod format;
 mod layout;
 mod section;
 mod volume;
@@ -22,6 +23,7 @@ mod volume;
 pub use bounds::{BoundsLevel, MAX_LEVELS};
 pub use convert::{convert, convert_tree, MAX_MAP_BRICKS};
 pub use dda::{ray_box, RaySegment, SegmentIter};
+pub use format::{read_cbrk, write_cbrk};
 pub use layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS};
 pub use section::Section;
 pub use volume::{Atlas, BrickVolume, SourceInfo};

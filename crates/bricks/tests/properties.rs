@@ -243,3 +243,53 @@ fn conversion_counts_bricks_and_sanitises_bad_values() {
     assert_eq!(vol.voxel(IVec3::new(1, 1, 1) - vol.origin), 1.0);
     assert_eq!(vol.max_density(), 1.0 + 1.0 / (1 << 20) as f32);
 }
+
+#[test]
+fn cbrk_round_trip_is_bit_identical_and_corruption_is_an_error() {
+    let tree = random_tree(3, IVec3::new(-40, 7, 1000));
+    let dir = std::env::temp_dir().join(format!("cirrus-cbrk-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for precision in [Precision::F32, Precision::F16, Precision::U8] {
+        let mut vol = convert_tree(&tree, precision).unwrap();
+        vol.info.grid_name = "density".into();
+        let path = dir.join(format!("v_{}.cbrk", precision.name()));
+        cirrus_bricks::write_cbrk(&vol, &path).unwrap();
+        let back = cirrus_bricks::read_cbrk(&path).unwrap();
+        assert_eq!(back.info, vol.info);
+        assert_eq!(
+            (back.origin, back.dims, back.levels.len()),
+            (vol.origin, vol.dims, vol.levels.len())
+        );
+        for (a, b) in back.levels.iter().zip(&vol.levels) {
+            assert_eq!(
+                a.cells.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                b.cells.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+            );
+        }
+        for x in -45..30 {
+            for y in 0..70 {
+                let p = Vec3::new(x as f32 + 0.3, y as f32 + 0.6, 1020.25) - vol.origin.as_vec3();
+                assert_eq!(back.trilinear(p).to_bits(), vol.trilinear(p).to_bits());
+            }
+        }
+        // Truncations and flipped bytes are errors, never panics.
+        let bytes = std::fs::read(&path).unwrap();
+        for cut in [0, 7, 100, 1023, bytes.len() / 2, bytes.len() - 1] {
+            std::fs::write(&path, &bytes[..cut]).unwrap();
+            assert!(
+                cirrus_bricks::read_cbrk(&path).is_err(),
+                "truncated at {cut}"
+            );
+        }
+        for at in [0, 9, 20, 300, 1030, bytes.len() - 3] {
+            let mut b = bytes.clone();
+            b[at] ^= 0x5a;
+            std::fs::write(&path, &b).unwrap();
+            assert!(
+                cirrus_bricks::read_cbrk(&path).is_err(),
+                "flipped byte {at}"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
