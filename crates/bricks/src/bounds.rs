@@ -2,23 +2,29 @@
 //! level below, a (min, max) pair that bounds the trilinearly interpolated
 //! density anywhere inside the cell.
 //!
-//! Level 0 cells are bricks (8 voxels a side); level `k` cells are
-//! `8 << k` voxels a side. A brick's bounds are taken over the voxels
-//! `[o, o + 8]` per axis: trilinear interpolation at any point of
-//! `[o, o + 8)` reads exactly those (its corner voxels are `floor(p)` and
-//! `floor(p) + 1`), and is a convex combination of them, so it can neither
-//! exceed their max nor fall below their min. Coarser cells take the max of
+//! Level 0 cells are `CELL` = 4 voxels a side (8 per brick); level `k`
+//! cells are `4 << k` voxels a side, so level 1 is the brick. A cell's
+//! bounds are taken over the voxels `[o, o + CELL]` per axis: trilinear
+//! interpolation at any point of `[o, o + CELL)` reads exactly those (its
+//! corner voxels are `floor(p)` and `floor(p) + 1`), and is a convex
+//! combination of them, so it can neither exceed their max nor fall below
+//! their min. Cells finer than a brick are what lets the bounds follow a
+//! cloud's soft edges: at 4 voxels (+1 for the filter) they are tighter than
+//! pbrt-v4's 64^3 grid over a few-hundred-voxel cloud, whose cells are a few
+//! voxels wide but padded by one voxel on both sides. Coarser cells take the max of
 //! their children's maxima and the min of their minima (a child outside the
 //! grid counts as (0, 0): the density there is zero). The pyramid stops at a
 //! single cell or at [`MAX_LEVELS`].
 //!
 //! Stored as f32 pairs, 8 bytes a cell; the whole pyramid is about
-//! 8/7 x 8 bytes per brick.
+//! 8/7 x 64 bytes per brick (an eighth of a u8 brick's voxels).
 
 use crate::section::Section;
 
-/// Most levels: level 7 cells are 1024 voxels wide.
-pub const MAX_LEVELS: usize = 8;
+/// log2 of the side of a level-0 cell in voxels.
+pub const CELL_LOG2: u32 = 2;
+/// Most levels: level 8 cells are 1024 voxels wide.
+pub const MAX_LEVELS: usize = 9;
 
 /// One level of the pyramid: a dense grid of (min, max) pairs.
 #[derive(Clone, Debug)]

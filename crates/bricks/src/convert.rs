@@ -3,7 +3,7 @@
 //! built over what was stored (so it bounds the values the renderer reads,
 //! after quantisation).
 
-use crate::bounds::{build_pyramid, BoundsLevel};
+use crate::bounds::{build_pyramid, BoundsLevel, CELL_LOG2};
 use crate::layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS, MAX_BRICK_INDEX};
 use crate::volume::{Atlas, BrickVolume, SourceInfo};
 use crate::BrickError;
@@ -303,46 +303,44 @@ fn quantise(
     Ok(brick)
 }
 
-/// Level 0 of the pyramid: for each brick, the range of the stored voxels
-/// over `[o, o + 8]` per axis (its own 8^3 and the first layer of its +x, +y
-/// and +z neighbours), widened by [`BOUND_SLACK`] unless the range is a
-/// single value.
+/// Level 0 of the pyramid: for each 4^3 cell, the range of the stored
+/// voxels over `[o, o + 4]` per axis (the cell and the first layer of its
+/// +x, +y and +z neighbours), widened by [`BOUND_SLACK`] unless the range
+/// is a single value.
 fn brick_bounds(v: &BrickVolume) -> BoundsLevel {
-    let [dx, dy, dz] = v.dims.map(|d| d as i32);
+    let dims = v.dims.map(|d| d << (BRICK_LOG2 - CELL_LOG2));
+    let [dx, dy, dz] = dims.map(|d| d as i32);
     let cells: Vec<f32> = (0..dx)
         .into_par_iter()
         .flat_map_iter(|x| {
-            (0..dy)
-                .flat_map(move |y| (0..dz).map(move |z| IVec3::new(x, y, z)))
-                .flat_map(|b| {
-                    let (lo, hi) = brick_range(v, b);
-                    if lo == hi {
-                        [lo, hi]
-                    } else {
-                        [lo - lo.abs() * BOUND_SLACK, hi + hi.abs() * BOUND_SLACK]
-                    }
-                })
+            (0..dy).flat_map(move |y| (0..dz).map(move |z| IVec3::new(x, y, z))).flat_map(|c| {
+                let (lo, hi) = cell_range(v, c);
+                if lo == hi {
+                    [lo, hi]
+                } else {
+                    [lo - lo.abs() * BOUND_SLACK, hi + hi.abs() * BOUND_SLACK]
+                }
+            })
         })
         .collect();
-    BoundsLevel {
-        dims: v.dims,
-        cells: cells.into(),
-    }
+    BoundsLevel { dims, cells: cells.into() }
 }
 
-fn brick_range(v: &BrickVolume, b: IVec3) -> (f32, f32) {
-    let neighbours_all_empty = (0..8).all(|k| {
-        let d = IVec3::new(k >> 2, (k >> 1) & 1, k & 1);
-        v.brick_ref(b + d) == BrickRef::Empty
-    });
-    if neighbours_all_empty {
+fn cell_range(v: &BrickVolume, c: IVec3) -> (f32, f32) {
+    let size = 1 << CELL_LOG2;
+    let o = c * size;
+    // The voxels [o, o + size] lie in at most 2^3 bricks; all empty means 0.
+    let b0 = o >> BRICK_LOG2 as i32;
+    let b1 = (o + size) >> BRICK_LOG2 as i32;
+    let all_empty = (b0.x..=b1.x)
+        .all(|x| (b0.y..=b1.y).all(|y| (b0.z..=b1.z).all(|z| v.brick_ref(IVec3::new(x, y, z)) == BrickRef::Empty)));
+    if all_empty {
         return (0.0, 0.0);
     }
-    let o = b * BRICK;
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for x in 0..=BRICK {
-        for y in 0..=BRICK {
-            for z in 0..=BRICK {
+    for x in 0..=size {
+        for y in 0..=size {
+            for z in 0..=size {
                 let s = v.voxel(o + IVec3::new(x, y, z));
                 lo = lo.min(s);
                 hi = hi.max(s);

@@ -20,7 +20,7 @@
 //! dimensions, and every brick reference against the tables: a corrupt or
 //! truncated file is an error, never a panic.
 
-use crate::bounds::{BoundsLevel, MAX_LEVELS};
+use crate::bounds::{BoundsLevel, CELL_LOG2, MAX_LEVELS};
 use crate::layout::{BrickRef, Precision};
 use crate::section::Section;
 use crate::volume::{Atlas, BrickVolume, SourceInfo};
@@ -299,7 +299,7 @@ pub fn read_cbrk(path: &Path) -> Result<BrickVolume, BrickError> {
         }
     }
     let mut levels = Vec::new();
-    let mut expect = dims;
+    let mut expect = dims.map(|d| d << (crate::layout::BRICK_LOG2 - CELL_LOG2));
     for (k, &ld) in level_dims.iter().enumerate().take(level_count) {
         if ld != expect {
             return Err(err(

@@ -12,17 +12,20 @@
 //! memory-maps the `.cbrk` file of a converted volume, and `baseline.rs`
 //! builds the coarser majorant structures the benchmarks compare against.
 
+mod baseline;
 mod bounds;
 mod convert;
 mod dda;
 mod format;
 mod layout;
+pub mod measure;
 mod section;
 mod volume;
 
-pub use bounds::{BoundsLevel, MAX_LEVELS};
+pub use baseline::{FixedGridIter, FixedMajorantGrid, GlobalMajorant};
+pub use bounds::{BoundsLevel, CELL_LOG2, MAX_LEVELS};
 pub use convert::{convert, convert_tree, MAX_MAP_BRICKS};
-pub use dda::{ray_box, RaySegment, SegmentIter};
+pub use dda::{ray_box, RaySegment, SegmentIter, TIGHT_ENOUGH};
 pub use format::{read_cbrk, write_cbrk};
 pub use layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS};
 pub use section::Section;

@@ -293,3 +293,32 @@ fn cbrk_round_trip_is_bit_identical_and_corruption_is_an_error() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn baselines_bound_the_density_too_and_the_hierarchy_is_tighter() {
+    use cirrus_bricks::measure::{density_integral, measure, random_rays};
+    use cirrus_bricks::{FixedMajorantGrid, GlobalMajorant};
+    let tree = random_tree(11, IVec3::ZERO);
+    let vol = convert_tree(&tree, Precision::F32).unwrap();
+    let global = GlobalMajorant::new(&vol);
+    let fixed = FixedMajorantGrid::build(&vol, 16);
+    let rays = random_rays(&vol, 300, 5);
+    let integrals: Vec<f64> = rays.iter().map(|r| density_integral(&vol, r)).collect();
+    for r in &rays {
+        for s in fixed.segments(r.origin, r.dir, 0.0, r.t_max) {
+            for k in 1..8 {
+                let t = s.t0 + (s.t1 - s.t0) * k as f32 / 8.0;
+                let d = vol.trilinear(r.origin + r.dir * t);
+                assert!(d <= s.majorant, "fixed grid: density {d} above majorant {}", s.majorant);
+            }
+        }
+    }
+    let a = measure("global", &rays, &integrals, |r| global.segments(r.origin, r.dir, 0.0, r.t_max));
+    let b = measure("fixed", &rays, &integrals, |r| fixed.segments(r.origin, r.dir, 0.0, r.t_max));
+    let c = measure("hierarchy", &rays, &integrals, |r| vol.segments(r.origin, r.dir, 0.0, r.t_max));
+    // Every structure bounds the density, so no tightness can fall below 1.
+    for m in [&a, &b, &c] {
+        assert!(m.tightness >= 1.0 - 1e-3, "{} tightness {}", m.name, m.tightness);
+    }
+    assert!(c.tightness < b.tightness && b.tightness < a.tightness, "{a:?}\n{b:?}\n{c:?}");
+}

@@ -23,12 +23,15 @@ struct Cli {
 enum Command {
     /// Print the grids of a .vdb or .nvdb file.
     Info(commands::info::InfoArgs),
+    /// Convert a float grid into sparse bricks (.cbrk).
+    Convert(commands::convert::ConvertArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
+        Command::Convert(args) => commands::convert::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

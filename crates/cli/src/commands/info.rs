@@ -15,6 +15,9 @@ pub struct InfoArgs {
 }
 
 pub fn run(args: &InfoArgs) -> CliResult {
+    if args.file.extension().is_some_and(|e| e == "cbrk") {
+        return run_cbrk(args);
+    }
     let file = VolumeFile::open(&args.file)?;
     let mut grids = Vec::new();
     for (i, info) in file.grids().into_iter().enumerate() {
@@ -162,4 +165,37 @@ fn print_table(r: &Json) {
             println!("  {k:<15} {}", v.replace('"', ""));
         }
     }
+}
+
+/// `cirrus info OUT.cbrk`: what the conversion kept and what it costs.
+fn run_cbrk(args: &InfoArgs) -> CliResult {
+    let v = cirrus_bricks::read_cbrk(&args.file)?;
+    let (map, tables, atlas, levels) = v.memory_bytes();
+    let i = &v.info;
+    let report = json!({
+        "file": args.file.display().to_string(),
+        "format": "cbrk",
+        "grid": i.grid_name,
+        "precision": v.precision().name(),
+        "active_voxels": i.active_voxels,
+        "bricks_stored": i.bricks_stored,
+        "bricks_constant": i.bricks_constant,
+        "bricks_skipped": i.bricks_empty,
+        "brick_dims": v.dims,
+        "index_origin": v.origin.to_array(),
+        "max_error": num(i.max_error as f64),
+        "sanitized_voxels": i.sanitized_voxels,
+        "max_density": num(v.max_density() as f64),
+        "bytes": {"map": map, "constants_and_ranges": tables, "atlas": atlas, "levels": levels, "total": v.total_bytes()},
+    });
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!("{} (cbrk, grid {:?}, {} precision)", args.file.display(), i.grid_name, v.precision().name());
+        println!("  active voxels    {}", i.active_voxels);
+        println!("  bricks           {} stored, {} constant, {} skipped (empty)", i.bricks_stored, i.bricks_constant, i.bricks_empty);
+        println!("  max error        {:e}", i.max_error);
+        println!("  bytes            map {map}, tables {tables}, atlas {atlas}, levels {levels:?}, total {}", v.total_bytes());
+    }
+    Ok(())
 }

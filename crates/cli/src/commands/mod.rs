@@ -1,3 +1,4 @@
+pub mod convert;
 pub mod info;
 
 /// The error every subcommand returns: printed once by `main`.

@@ -1,0 +1,73 @@
+//! `cirrus convert IN [--grid NAME] [--precision f32|f16|u8] -o OUT.cbrk`.
+
+use super::CliResult;
+use cirrus_bricks::{convert, write_cbrk, Precision};
+use cirrus_vdb::VolumeFile;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct ConvertArgs {
+    /// A .vdb or .nvdb file.
+    pub input: PathBuf,
+    /// The float grid to convert (default: "density", else the first float grid).
+    #[arg(long)]
+    pub grid: Option<String>,
+    /// Voxel precision of the stored bricks.
+    #[arg(long, default_value = "f32", value_parser = ["f32", "f16", "u8"])]
+    pub precision: String,
+    /// The .cbrk file to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// Picks the grid to render or convert: the one named, else "density",
+/// else the first float grid.
+pub fn choose_grid(file: &VolumeFile, name: Option<&str>) -> Result<usize, Box<dyn std::error::Error>> {
+    if let Some(name) = name {
+        return Ok(file.find_grid(name)?);
+    }
+    let grids = file.grids();
+    grids
+        .iter()
+        .position(|g| g.name == "density" && g.value_type == Some(cirrus_vdb::ValueType::Float))
+        .or_else(|| grids.iter().position(|g| g.value_type == Some(cirrus_vdb::ValueType::Float)))
+        .ok_or_else(|| format!("{}: no float grid to use (grids: {})", file.path().display(), names(&grids)).into())
+}
+
+fn names(grids: &[&cirrus_vdb::GridInfo]) -> String {
+    grids.iter().map(|g| format!("{} ({})", g.name, g.type_name)).collect::<Vec<_>>().join(", ")
+}
+
+pub fn run(args: &ConvertArgs) -> CliResult {
+    let precision = Precision::from_name(&args.precision).expect("clap checked the name");
+    let file = VolumeFile::open(&args.input)?;
+    let index = choose_grid(&file, args.grid.as_deref())?;
+    let start = Instant::now();
+    let grid = file.read_grid(index)?;
+    let read_s = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let volume = convert(&grid, precision).map_err(|e| format!("{}: {e}", args.input.display()))?;
+    let convert_s = start.elapsed().as_secs_f64();
+    write_cbrk(&volume, &args.output)?;
+    let i = &volume.info;
+    eprintln!(
+        "{}: grid {:?}, {} active voxels -> {} bricks stored, {} constant, {} empty ({} precision, max error {:e}); read {:.3} s, converted {:.3} s ({:.1} M active voxels/s), {} bytes",
+        args.output.display(),
+        i.grid_name,
+        i.active_voxels,
+        i.bricks_stored,
+        i.bricks_constant,
+        i.bricks_empty,
+        precision.name(),
+        i.max_error,
+        read_s,
+        convert_s,
+        i.active_voxels as f64 / convert_s.max(1e-9) / 1e6,
+        volume.total_bytes()
+    );
+    if i.sanitized_voxels > 0 {
+        eprintln!("warning: {} voxels were NaN, infinite or negative and are stored as 0", i.sanitized_voxels);
+    }
+    Ok(())
+}
