@@ -15,7 +15,7 @@
 //! The next descriptor starts at the previous grid's end offset, so listing
 //! the grids reads only descriptors, and reading one grid reads only its range.
 
-mod blosc;
+pub(crate) mod blosc;
 mod compression;
 mod tree_reader;
 
