@@ -21,14 +21,30 @@ pub struct GlobalMajorant {
 
 impl GlobalMajorant {
     pub fn new(volume: &BrickVolume) -> Self {
-        GlobalMajorant { majorant: volume.max_density(), extent: volume.local_extent() }
+        GlobalMajorant {
+            majorant: volume.max_density(),
+            extent: volume.local_extent(),
+        }
     }
 
-    pub fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> impl Iterator<Item = RaySegment> {
+    pub fn segments(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> impl Iterator<Item = RaySegment> {
         let (a, b) = ray_box(origin, dir.recip(), Vec3::ZERO, self.extent);
         let (t0, t1) = (a.max(t_min), b.min(t_max));
         let majorant = self.majorant;
-        (t0 < t1 && majorant > 0.0).then_some(RaySegment { t0, t1, minorant: 0.0, majorant }).into_iter()
+        (t0 < t1 && majorant > 0.0)
+            .then_some(RaySegment {
+                t0,
+                t1,
+                minorant: 0.0,
+                majorant,
+            })
+            .into_iter()
     }
 }
 
@@ -57,7 +73,9 @@ impl FixedMajorantGrid {
                 for bx in lo.x.div_euclid(8)..=hi.x.div_euclid(8) {
                     for by in lo.y.div_euclid(8)..=hi.y.div_euclid(8) {
                         for bz in lo.z.div_euclid(8)..=hi.z.div_euclid(8) {
-                            if volume.brick_ref(IVec3::new(bx, by, bz)) == crate::layout::BrickRef::Empty {
+                            if volume.brick_ref(IVec3::new(bx, by, bz))
+                                == crate::layout::BrickRef::Empty
+                            {
                                 continue;
                             }
                             for x in (bx * 8).max(lo.x)..=(bx * 8 + 7).min(hi.x) {
@@ -73,7 +91,12 @@ impl FixedMajorantGrid {
                 m
             })
             .collect();
-        FixedMajorantGrid { res, cell, extent, max }
+        FixedMajorantGrid {
+            res,
+            cell,
+            extent,
+            max,
+        }
     }
 
     pub fn bytes(&self) -> usize {
@@ -86,12 +109,35 @@ impl FixedMajorantGrid {
         let (a, b) = ray_box(origin, inv, Vec3::ZERO, self.extent);
         let (t, t_end) = (a.max(t_min), b.min(t_max));
         let p = origin + dir * t.max(a);
-        let cell = (p / self.cell).floor().as_ivec3().clamp(IVec3::ZERO, IVec3::splat(self.res - 1));
-        let step = IVec3::new(dir.x.signum() as i32, dir.y.signum() as i32, dir.z.signum() as i32);
+        let cell = (p / self.cell)
+            .floor()
+            .as_ivec3()
+            .clamp(IVec3::ZERO, IVec3::splat(self.res - 1));
+        let step = IVec3::new(
+            dir.x.signum() as i32,
+            dir.y.signum() as i32,
+            dir.z.signum() as i32,
+        );
         let next_boundary = (cell + step.max(IVec3::ZERO)).as_vec3() * self.cell;
-        let t_next = Vec3::select(dir.cmpeq(Vec3::ZERO), Vec3::INFINITY, (next_boundary - origin) * inv);
-        let t_delta = Vec3::select(dir.cmpeq(Vec3::ZERO), Vec3::INFINITY, (self.cell * inv).abs());
-        FixedGridIter { grid: self, cell, step, t, t_end, t_next, t_delta }
+        let t_next = Vec3::select(
+            dir.cmpeq(Vec3::ZERO),
+            Vec3::INFINITY,
+            (next_boundary - origin) * inv,
+        );
+        let t_delta = Vec3::select(
+            dir.cmpeq(Vec3::ZERO),
+            Vec3::INFINITY,
+            (self.cell * inv).abs(),
+        );
+        FixedGridIter {
+            grid: self,
+            cell,
+            step,
+            t,
+            t_end,
+            t_next,
+            t_delta,
+        }
     }
 }
 
@@ -109,7 +155,10 @@ impl Iterator for FixedGridIter<'_> {
     type Item = RaySegment;
     fn next(&mut self) -> Option<RaySegment> {
         let r = self.grid.res;
-        while self.t < self.t_end && self.cell.cmpge(IVec3::ZERO).all() && self.cell.cmplt(IVec3::splat(r)).all() {
+        while self.t < self.t_end
+            && self.cell.cmpge(IVec3::ZERO).all()
+            && self.cell.cmplt(IVec3::splat(r)).all()
+        {
             let axis = if self.t_next.x < self.t_next.y && self.t_next.x < self.t_next.z {
                 0
             } else if self.t_next.y < self.t_next.z {
@@ -124,7 +173,12 @@ impl Iterator for FixedGridIter<'_> {
             self.cell[axis] += self.step[axis];
             self.t_next[axis] += self.t_delta[axis];
             if m > 0.0 && t1 > t0 {
-                return Some(RaySegment { t0, t1, minorant: 0.0, majorant: m });
+                return Some(RaySegment {
+                    t0,
+                    t1,
+                    minorant: 0.0,
+                    majorant: m,
+                });
             }
         }
         None

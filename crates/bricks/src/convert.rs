@@ -306,46 +306,76 @@ fn quantise(
 /// Level 0 of the pyramid: for each 4^3 cell, the range of the stored
 /// voxels over `[o, o + 4]` per axis (the cell and the first layer of its
 /// +x, +y and +z neighbours), widened by [`BOUND_SLACK`] unless the range
-/// is a single value.
+/// is a single value. Computed a brick at a time from one gathered 9^3
+/// block (the brick and its +1 layer), in parallel over bricks.
 fn brick_bounds(v: &BrickVolume) -> BoundsLevel {
+    const SUB: usize = 1 << (BRICK_LOG2 - CELL_LOG2); // cells per brick side
     let dims = v.dims.map(|d| d << (BRICK_LOG2 - CELL_LOG2));
-    let [dx, dy, dz] = dims.map(|d| d as i32);
-    let cells: Vec<f32> = (0..dx)
+    let [bx, by, bz] = v.dims.map(|d| d as i32);
+    let per_brick: Vec<[[f32; 2]; SUB * SUB * SUB]> = (0..bx * by * bz)
         .into_par_iter()
-        .flat_map_iter(|x| {
-            (0..dy).flat_map(move |y| (0..dz).map(move |z| IVec3::new(x, y, z))).flat_map(|c| {
-                let (lo, hi) = cell_range(v, c);
-                if lo == hi {
-                    [lo, hi]
-                } else {
-                    [lo - lo.abs() * BOUND_SLACK, hi + hi.abs() * BOUND_SLACK]
-                }
-            })
-        })
+        .map(|i| brick_cell_ranges(v, IVec3::new(i / (by * bz), (i / bz) % by, i % bz)))
         .collect();
-    BoundsLevel { dims, cells: cells.into() }
+    let mut cells = vec![0f32; 2 * dims.iter().map(|&d| d as usize).product::<usize>()];
+    let (dy, dz) = (dims[1] as usize, dims[2] as usize);
+    for (i, ranges) in per_brick.iter().enumerate() {
+        let b = [
+            i / (by * bz) as usize,
+            (i / bz as usize) % by as usize,
+            i % bz as usize,
+        ];
+        for (k, &[lo, hi]) in ranges.iter().enumerate() {
+            let c = [
+                b[0] * SUB + k / (SUB * SUB),
+                b[1] * SUB + (k / SUB) % SUB,
+                b[2] * SUB + k % SUB,
+            ];
+            let at = 2 * ((c[0] * dy + c[1]) * dz + c[2]);
+            let (lo, hi) = if lo == hi {
+                (lo, hi)
+            } else {
+                (lo - lo.abs() * BOUND_SLACK, hi + hi.abs() * BOUND_SLACK)
+            };
+            cells[at] = lo;
+            cells[at + 1] = hi;
+        }
+    }
+    BoundsLevel {
+        dims,
+        cells: cells.into(),
+    }
 }
 
-fn cell_range(v: &BrickVolume, c: IVec3) -> (f32, f32) {
-    let size = 1 << CELL_LOG2;
-    let o = c * size;
-    // The voxels [o, o + size] lie in at most 2^3 bricks; all empty means 0.
-    let b0 = o >> BRICK_LOG2 as i32;
-    let b1 = (o + size) >> BRICK_LOG2 as i32;
-    let all_empty = (b0.x..=b1.x)
-        .all(|x| (b0.y..=b1.y).all(|y| (b0.z..=b1.z).all(|z| v.brick_ref(IVec3::new(x, y, z)) == BrickRef::Empty)));
+/// The (min, max) of each 4^3 cell of brick `b` over its `[o, o + 4]` voxels.
+fn brick_cell_ranges(v: &BrickVolume, b: IVec3) -> [[f32; 2]; 8] {
+    let all_empty =
+        (0..8).all(|k| v.brick_ref(b + IVec3::new(k >> 2, (k >> 1) & 1, k & 1)) == BrickRef::Empty);
     if all_empty {
-        return (0.0, 0.0);
+        return [[0.0; 2]; 8];
     }
-    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for x in 0..=size {
-        for y in 0..=size {
-            for z in 0..=size {
-                let s = v.voxel(o + IVec3::new(x, y, z));
-                lo = lo.min(s);
-                hi = hi.max(s);
+    const N: usize = BRICK as usize + 1;
+    let mut block = [0f32; N * N * N];
+    let o = b * BRICK;
+    for x in 0..N {
+        for y in 0..N {
+            for z in 0..N {
+                block[(x * N + y) * N + z] = v.voxel(o + IVec3::new(x as i32, y as i32, z as i32));
             }
         }
     }
-    (lo, hi)
+    let size = 1usize << CELL_LOG2;
+    std::array::from_fn(|k| {
+        let c = [(k >> 2) * size, ((k >> 1) & 1) * size, (k & 1) * size];
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for x in c[0]..=c[0] + size {
+            for y in c[1]..=c[1] + size {
+                for z in c[2]..=c[2] + size {
+                    let s = block[(x * N + y) * N + z];
+                    lo = lo.min(s);
+                    hi = hi.max(s);
+                }
+            }
+        }
+        [lo, hi]
+    })
 }

@@ -20,7 +20,9 @@ pub struct LocalRay {
 pub fn random_rays(volume: &BrickVolume, n: usize, seed: u64) -> Vec<LocalRay> {
     let mut s = seed ^ 0x9E37_79B9_7F4A_7C15;
     let mut rnd = move || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((s >> 40) as f32) / (1u64 << 24) as f32
     };
     let extent = volume.local_extent();
@@ -36,7 +38,11 @@ pub fn random_rays(volume: &BrickVolume, n: usize, seed: u64) -> Vec<LocalRay> {
         .map(|_| {
             let a = sphere();
             let b = sphere();
-            LocalRay { origin: a, dir: (b - a).normalize_or(Vec3::X), t_max: (b - a).length() }
+            LocalRay {
+                origin: a,
+                dir: (b - a).normalize_or(Vec3::X),
+                t_max: (b - a).length(),
+            }
         })
         .collect()
 }
@@ -46,7 +52,9 @@ pub fn random_rays(volume: &BrickVolume, n: usize, seed: u64) -> Vec<LocalRay> {
 pub fn density_integral(volume: &BrickVolume, ray: &LocalRay) -> f64 {
     let h = 0.25f32;
     let n = (ray.t_max / h).ceil() as usize;
-    (0..n).map(|i| volume.trilinear(ray.origin + ray.dir * ((i as f32 + 0.5) * h)) as f64 * h as f64).sum()
+    (0..n)
+        .map(|i| volume.trilinear(ray.origin + ray.dir * ((i as f32 + 0.5) * h)) as f64 * h as f64)
+        .sum()
 }
 
 /// What one majorant structure did on a set of rays.

@@ -306,16 +306,34 @@ fn baselines_bound_the_density_too_and_the_hierarchy_is_tighter() {
             for k in 1..8 {
                 let t = s.t0 + (s.t1 - s.t0) * k as f32 / 8.0;
                 let d = vol.trilinear(r.origin + r.dir * t);
-                assert!(d <= s.majorant, "fixed grid: density {d} above majorant {}", s.majorant);
+                assert!(
+                    d <= s.majorant,
+                    "fixed grid: density {d} above majorant {}",
+                    s.majorant
+                );
             }
         }
     }
-    let a = measure("global", &rays, &integrals, |r| global.segments(r.origin, r.dir, 0.0, r.t_max));
-    let b = measure("fixed", &rays, &integrals, |r| fixed.segments(r.origin, r.dir, 0.0, r.t_max));
-    let c = measure("hierarchy", &rays, &integrals, |r| vol.segments(r.origin, r.dir, 0.0, r.t_max));
+    let a = measure("global", &rays, &integrals, |r| {
+        global.segments(r.origin, r.dir, 0.0, r.t_max)
+    });
+    let b = measure("fixed", &rays, &integrals, |r| {
+        fixed.segments(r.origin, r.dir, 0.0, r.t_max)
+    });
+    let c = measure("hierarchy", &rays, &integrals, |r| {
+        vol.segments(r.origin, r.dir, 0.0, r.t_max)
+    });
     // Every structure bounds the density, so no tightness can fall below 1.
     for m in [&a, &b, &c] {
-        assert!(m.tightness >= 1.0 - 1e-3, "{} tightness {}", m.name, m.tightness);
+        assert!(
+            m.tightness >= 1.0 - 1e-3,
+            "{} tightness {}",
+            m.name,
+            m.tightness
+        );
     }
-    assert!(c.tightness < b.tightness && b.tightness < a.tightness, "{a:?}\n{b:?}\n{c:?}");
+    assert!(
+        c.tightness < b.tightness && b.tightness < a.tightness,
+        "{a:?}\n{b:?}\n{c:?}"
+    );
 }

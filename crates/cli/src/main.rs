@@ -25,6 +25,9 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Convert a float grid into sparse bricks (.cbrk).
     Convert(commands::convert::ConvertArgs),
+    /// Benchmarks that print figures.
+    #[command(subcommand)]
+    Bench(commands::bench::BenchCommand),
 }
 
 fn main() -> ExitCode {
@@ -32,6 +35,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
         Command::Convert(args) => commands::convert::run(&args),
+        Command::Bench(cmd) => commands::bench::run(&cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -23,7 +23,10 @@ pub struct ConvertArgs {
 
 /// Picks the grid to render or convert: the one named, else "density",
 /// else the first float grid.
-pub fn choose_grid(file: &VolumeFile, name: Option<&str>) -> Result<usize, Box<dyn std::error::Error>> {
+pub fn choose_grid(
+    file: &VolumeFile,
+    name: Option<&str>,
+) -> Result<usize, Box<dyn std::error::Error>> {
     if let Some(name) = name {
         return Ok(file.find_grid(name)?);
     }
@@ -31,12 +34,27 @@ pub fn choose_grid(file: &VolumeFile, name: Option<&str>) -> Result<usize, Box<d
     grids
         .iter()
         .position(|g| g.name == "density" && g.value_type == Some(cirrus_vdb::ValueType::Float))
-        .or_else(|| grids.iter().position(|g| g.value_type == Some(cirrus_vdb::ValueType::Float)))
-        .ok_or_else(|| format!("{}: no float grid to use (grids: {})", file.path().display(), names(&grids)).into())
+        .or_else(|| {
+            grids
+                .iter()
+                .position(|g| g.value_type == Some(cirrus_vdb::ValueType::Float))
+        })
+        .ok_or_else(|| {
+            format!(
+                "{}: no float grid to use (grids: {})",
+                file.path().display(),
+                names(&grids)
+            )
+            .into()
+        })
 }
 
 fn names(grids: &[&cirrus_vdb::GridInfo]) -> String {
-    grids.iter().map(|g| format!("{} ({})", g.name, g.type_name)).collect::<Vec<_>>().join(", ")
+    grids
+        .iter()
+        .map(|g| format!("{} ({})", g.name, g.type_name))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 pub fn run(args: &ConvertArgs) -> CliResult {
@@ -67,7 +85,10 @@ pub fn run(args: &ConvertArgs) -> CliResult {
         volume.total_bytes()
     );
     if i.sanitized_voxels > 0 {
-        eprintln!("warning: {} voxels were NaN, infinite or negative and are stored as 0", i.sanitized_voxels);
+        eprintln!(
+            "warning: {} voxels were NaN, infinite or negative and are stored as 0",
+            i.sanitized_voxels
+        );
     }
     Ok(())
 }

@@ -191,9 +191,17 @@ fn run_cbrk(args: &InfoArgs) -> CliResult {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        println!("{} (cbrk, grid {:?}, {} precision)", args.file.display(), i.grid_name, v.precision().name());
+        println!(
+            "{} (cbrk, grid {:?}, {} precision)",
+            args.file.display(),
+            i.grid_name,
+            v.precision().name()
+        );
         println!("  active voxels    {}", i.active_voxels);
-        println!("  bricks           {} stored, {} constant, {} skipped (empty)", i.bricks_stored, i.bricks_constant, i.bricks_empty);
+        println!(
+            "  bricks           {} stored, {} constant, {} skipped (empty)",
+            i.bricks_stored, i.bricks_constant, i.bricks_empty
+        );
         println!("  max error        {:e}", i.max_error);
         println!("  bytes            map {map}, tables {tables}, atlas {atlas}, levels {levels:?}, total {}", v.total_bytes());
     }
