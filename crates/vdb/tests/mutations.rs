@@ -32,7 +32,11 @@ fn corpus_files() -> Vec<PathBuf> {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|e| e == "vdb" || e == "nvdb"))
         // Small files keep 12,000 loads fast; they cover every codec and layout.
-        .filter(|p| std::fs::metadata(p).map(|m| m.len() < 400_000).unwrap_or(false))
+        .filter(|p| {
+            std::fs::metadata(p)
+                .map(|m| m.len() < 400_000)
+                .unwrap_or(false)
+        })
         .collect();
     files.sort();
     files
@@ -59,7 +63,7 @@ fn mutate(rng: &mut Rng, bytes: &mut Vec<u8>) {
                 bytes[i] = rng.next() as u8;
             }
         }
-        2 => {
+        2 if bytes.len() >= 8 => {
             // A size or offset field gone wild.
             let i = rng.below(bytes.len().saturating_sub(8));
             let v = [u64::MAX, 1 << 40, 1 << 31, rng.next(), 0][rng.below(5)];
@@ -82,7 +86,11 @@ fn mutate(rng: &mut Rng, bytes: &mut Vec<u8>) {
 #[test]
 fn mutated_corpus_files_error_cleanly_and_never_panic() {
     let files = corpus_files();
-    assert!(files.len() >= 10, "expected the corpus in data/, found {} files", files.len());
+    assert!(
+        files.len() >= 10,
+        "expected the corpus in data/, found {} files",
+        files.len()
+    );
     let dir = std::env::temp_dir().join(format!("cirrus-mutations-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let target = dir.join("mutant.vdb");
@@ -100,16 +108,25 @@ fn mutated_corpus_files_error_cleanly_and_never_panic() {
         match catch_unwind(AssertUnwindSafe(|| load(&target))) {
             Ok(Ok(_)) => loaded += 1,
             Ok(Err(msg)) => {
-                assert!(msg.contains("mutant.vdb"), "error does not name the file: {msg}");
+                assert!(
+                    msg.contains("mutant.vdb"),
+                    "error does not name the file: {msg}"
+                );
                 refused += 1
             }
             Err(_) => panicked.push(format!("mutation {k} of {}", src.display())),
         }
     }
     std::fs::remove_dir_all(&dir).ok();
-    eprintln!("{MUTATIONS} mutations: {loaded} loaded, {refused} refused with an error, {} panicked", panicked.len());
+    eprintln!(
+        "{MUTATIONS} mutations: {loaded} loaded, {refused} refused with an error, {} panicked",
+        panicked.len()
+    );
     assert!(panicked.is_empty(), "panics:\n{}", panicked.join("\n"));
-    assert!(refused > MUTATIONS / 4, "only {refused} mutants were refused: the mutations are too gentle to test anything");
+    assert!(
+        refused > MUTATIONS / 4,
+        "only {refused} mutants were refused: the mutations are too gentle to test anything"
+    );
 }
 
 #[test]
@@ -118,24 +135,39 @@ fn empty_random_and_truncated_files_are_clear_errors() {
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join("bad.vdb");
     std::fs::write(&p, b"").unwrap();
-    let e = VolumeFile::open(&p).err().expect("empty file must fail").to_string();
+    let e = VolumeFile::open(&p)
+        .err()
+        .expect("empty file must fail")
+        .to_string();
     assert!(e.contains("bad.vdb") && e.contains("ends early"), "{e}");
     let mut rng = Rng(42);
     let random: Vec<u8> = (0..4096).map(|_| rng.next() as u8).collect();
     std::fs::write(&p, &random).unwrap();
-    let e = VolumeFile::open(&p).err().expect("random bytes must fail").to_string();
+    let e = VolumeFile::open(&p)
+        .err()
+        .expect("random bytes must fail")
+        .to_string();
     assert!(e.contains("not an OpenVDB or NanoVDB file"), "{e}");
     let missing = dir.join("missing.vdb");
-    let e = VolumeFile::open(&missing).err().expect("missing file must fail").to_string();
+    let e = VolumeFile::open(&missing)
+        .err()
+        .expect("missing file must fail")
+        .to_string();
     assert!(e.contains("missing.vdb"), "{e}");
     // Every prefix of a real file up to its first kilobyte, then coarser.
     for src in corpus_files().iter().take(6) {
         let bytes = std::fs::read(src).unwrap();
-        let cuts: Vec<usize> = (0..bytes.len().min(1024)).chain((1024..bytes.len()).step_by(997)).collect();
+        let cuts: Vec<usize> = (0..bytes.len().min(1024))
+            .chain((1024..bytes.len()).step_by(997))
+            .collect();
         for cut in cuts {
             std::fs::write(&p, &bytes[..cut]).unwrap();
             match catch_unwind(AssertUnwindSafe(|| load(&p))) {
-                Ok(Ok(_)) => panic!("{} truncated to {cut} of {} bytes loaded", src.display(), bytes.len()),
+                Ok(Ok(_)) => panic!(
+                    "{} truncated to {cut} of {} bytes loaded",
+                    src.display(),
+                    bytes.len()
+                ),
                 Ok(Err(_)) => {}
                 Err(_) => panic!("{} truncated to {cut} bytes panicked", src.display()),
             }

@@ -124,15 +124,24 @@ impl NanoIndex {
             }
             let magic = &head[..8];
             if !MAGICS.iter().any(|m| magic == m.as_slice()) {
-                return Err(corrupt(format!("no NanoVDB segment at byte {pos} (found {magic:02x?})")));
+                return Err(corrupt(format!(
+                    "no NanoVDB segment at byte {pos} (found {magic:02x?})"
+                )));
             }
-            let word = |at: usize| head.get(at..at + 4).map(|b| u32::from_le_bytes(b.try_into().unwrap()));
+            let word = |at: usize| {
+                head.get(at..at + 4)
+                    .map(|b| u32::from_le_bytes(b.try_into().unwrap()))
+            };
             let segment_version = word(8).unwrap_or(0);
             let grid_version = word(16).unwrap_or(0);
             // "NanoVDB0" starts both segments and raw grids: a segment has its
             // version at byte 8, a grid at byte 16 (after its checksum).
             let grid_magic = magic == b"NanoVDB1";
-            let version = if grid_magic { grid_version } else { segment_version };
+            let version = if grid_magic {
+                grid_version
+            } else {
+                segment_version
+            };
             if !grid_magic && version_parts(segment_version).0 == 32 {
                 pos = read_segment(src, pos, &mut grids, &mut locs)?;
             } else if magic != b"NanoVDB2" && version_parts(grid_version).0 == 32 {
@@ -166,7 +175,10 @@ impl NanoIndex {
         let buffer = match loc.codec {
             Codec::None => src.read_at(loc.data_pos, loc.grid_size, "grid buffer")?,
             Codec::Zip => inflate(&src.read_at(loc.data_pos, loc.file_size, "zip grid")?, loc)?,
-            Codec::Blosc => unblosc(&src.read_at(loc.data_pos, loc.file_size, "blosc grid")?, loc)?,
+            Codec::Blosc => unblosc(
+                &src.read_at(loc.data_pos, loc.file_size, "blosc grid")?,
+                loc,
+            )?,
             Codec::Other(c) => return Err(unsupported(format!("NanoVDB codec {c}"))),
         };
         let header = grid::read_header(&buffer)?;
@@ -182,57 +194,75 @@ impl NanoIndex {
 }
 
 /// Reads one segment's header and metadata at `pos`; returns where the next record starts.
-fn read_segment(src: &FileSource, pos: u64, grids: &mut Vec<GridInfo>, locs: &mut Vec<GridLoc>) -> KindResult<u64> {
-    let (metas, used) = src.parse_at(pos, "NanoVDB segment", |cur| {
-        cur.skip(12, "segment header")?;
-        let count = cur.u16("grid count")?;
-        let codec = match cur.u16("codec")? {
-            0 => Codec::None,
-            1 => Codec::Zip,
-            2 => Codec::Blosc,
-            c => Codec::Other(c),
+fn read_segment(
+    src: &FileSource,
+    pos: u64,
+    grids: &mut Vec<GridInfo>,
+    locs: &mut Vec<GridLoc>,
+) -> KindResult<u64> {
+    let head = src.read_at(pos, FILE_HEADER_SIZE as u64, "NanoVDB segment header")?;
+    let count = u16::from_le_bytes([head[12], head[13]]);
+    let codec = match u16::from_le_bytes([head[14], head[15]]) {
+        0 => Codec::None,
+        1 => Codec::Zip,
+        2 => Codec::Blosc,
+        c => Codec::Other(c),
+    };
+    let mut at = pos + FILE_HEADER_SIZE as u64;
+    let mut metas = Vec::new();
+    for _ in 0..count {
+        let meta = src.read_at(at, FILE_META_SIZE as u64, "NanoVDB grid metadata")?;
+        let m = Buf(&meta);
+        let name_size = m.u32(136, "name size")? as u64;
+        let name = src.read_at(at + FILE_META_SIZE as u64, name_size, "NanoVDB grid name")?;
+        let name = &name[..name.iter().position(|&c| c == 0).unwrap_or(name.len())];
+        metas.push((
+            m.u64(0, "grid size")?,
+            m.u64(8, "file size")?,
+            m.u32(32, "grid type")?,
+            String::from_utf8_lossy(name).into_owned(),
+        ));
+        at += FILE_META_SIZE as u64 + name_size;
+    }
+    for (grid_size, file_size, grid_type, name) in metas {
+        let end = at
+            .checked_add(file_size)
+            .filter(|&e| e <= src.len())
+            .ok_or(ErrorKind::Truncated {
+                what: "NanoVDB grid",
+                offset: at,
+                needed: file_size,
+                available: src.len().saturating_sub(at),
+            })?;
+        let limit = if codec == Codec::None {
+            file_size
+        } else {
+            file_size.saturating_mul(MAX_RATIO)
         };
-        cur.ensure(count as u64, FILE_META_SIZE as u64, "grid metadata")?;
-        let mut metas = Vec::with_capacity(count as usize);
-        for _ in 0..count {
-            let meta = cur.take(FILE_META_SIZE, "grid metadata")?;
-            let m = Buf(meta);
-            let name_size = m.u32(136, "name size")? as usize;
-            let name = cur.take(name_size, "grid name")?;
-            let name = &name[..name.iter().position(|&c| c == 0).unwrap_or(name.len())];
-            metas.push((
-                m.u64(0, "grid size")?,
-                m.u64(8, "file size")?,
-                m.u32(32, "grid type")?,
-                String::from_utf8_lossy(name).into_owned(),
-                codec,
-            ));
-        }
-        Ok(metas)
-    })?;
-    let mut at = pos + used;
-    for (grid_size, file_size, grid_type, name, codec) in metas {
-        let end = at.checked_add(file_size).filter(|&e| e <= src.len()).ok_or(ErrorKind::Truncated {
-            what: "NanoVDB grid",
-            offset: at,
-            needed: file_size,
-            available: src.len().saturating_sub(at),
-        })?;
-        let limit = if codec == Codec::None { file_size } else { file_size.saturating_mul(MAX_RATIO) };
         if grid_size < MIN_GRID_SIZE || grid_size > limit {
             return Err(corrupt(format!(
                 "grid {name:?} claims {grid_size} bytes from {file_size} bytes of file"
             )));
         }
         grids.push(grid_info(name, grid_type, file_size));
-        locs.push(GridLoc { data_pos: at, file_size, grid_size, codec });
+        locs.push(GridLoc {
+            data_pos: at,
+            file_size,
+            grid_size,
+            codec,
+        });
         at = end;
     }
     Ok(at)
 }
 
 /// Reads the `GridData` of a bare grid buffer at `pos`; returns where the next record starts.
-fn read_raw_grid(src: &FileSource, pos: u64, grids: &mut Vec<GridInfo>, locs: &mut Vec<GridLoc>) -> KindResult<u64> {
+fn read_raw_grid(
+    src: &FileSource,
+    pos: u64,
+    grids: &mut Vec<GridInfo>,
+    locs: &mut Vec<GridLoc>,
+) -> KindResult<u64> {
     let head = src.read_at(pos, GRID_DATA_SIZE as u64, "grid header")?;
     let h = grid::read_header(&head)?;
     let end = pos.checked_add(h.grid_size).filter(|&e| e <= src.len());
@@ -243,10 +273,18 @@ fn read_raw_grid(src: &FileSource, pos: u64, grids: &mut Vec<GridInfo>, locs: &m
         available: src.len() - pos,
     })?;
     if h.grid_size < MIN_GRID_SIZE {
-        return Err(corrupt(format!("grid {:?} claims only {} bytes", h.name, h.grid_size)));
+        return Err(corrupt(format!(
+            "grid {:?} claims only {} bytes",
+            h.name, h.grid_size
+        )));
     }
     grids.push(grid_info(h.name, h.grid_type, h.grid_size));
-    locs.push(GridLoc { data_pos: pos, file_size: h.grid_size, grid_size: h.grid_size, codec: Codec::None });
+    locs.push(GridLoc {
+        data_pos: pos,
+        file_size: h.grid_size,
+        grid_size: h.grid_size,
+        codec: Codec::None,
+    });
     Ok(end)
 }
 
@@ -259,7 +297,12 @@ fn framed<'a>(bytes: &'a [u8], at: usize, what: &str) -> KindResult<&'a [u8]> {
     usize::try_from(size)
         .ok()
         .and_then(|n| bytes.get(at + 8..(at + 8).checked_add(n)?))
-        .ok_or_else(|| corrupt(format!("{what} of {size} bytes runs past the grid's {} bytes", bytes.len())))
+        .ok_or_else(|| {
+            corrupt(format!(
+                "{what} of {size} bytes runs past the grid's {} bytes",
+                bytes.len()
+            ))
+        })
 }
 
 /// ZIP: one zlib stream that must inflate to exactly the grid size.
@@ -268,10 +311,17 @@ fn inflate(bytes: &[u8], loc: &GridLoc) -> KindResult<Vec<u8>> {
     let stream = framed(bytes, 0, "zip stream")?;
     let mut out = vec![0u8; loc.grid_size as usize];
     let mut z = flate2::read::ZlibDecoder::new(stream);
-    z.read_exact(&mut out).map_err(|e| corrupt(format!("zip grid of {} bytes: {e}", loc.grid_size)))?;
+    z.read_exact(&mut out)
+        .map_err(|e| corrupt(format!("zip grid of {} bytes: {e}", loc.grid_size)))?;
     let mut extra = [0u8; 1];
-    if z.read(&mut extra).map_err(|e| corrupt(format!("zip grid: {e}")))? != 0 {
-        return Err(corrupt(format!("zip grid inflates to more than its {} bytes", loc.grid_size)));
+    if z.read(&mut extra)
+        .map_err(|e| corrupt(format!("zip grid: {e}")))?
+        != 0
+    {
+        return Err(corrupt(format!(
+            "zip grid inflates to more than its {} bytes",
+            loc.grid_size
+        )));
     }
     Ok(out)
 }
