@@ -88,7 +88,7 @@ impl FileSource {
         what: &'static str,
         mut parse: impl FnMut(&mut crate::bytes::ByteCursor) -> KindResult<T>,
     ) -> KindResult<(T, u64)> {
-        let mut window = 4096u64;
+        let mut window = 256u64;
         loop {
             let buf = self.read_window(offset, window, what)?;
             let mut cur = crate::bytes::ByteCursor::new(&buf, offset);
