@@ -115,19 +115,23 @@ fn traverse(args: &TraverseArgs) -> CliResult {
         fixed_s
     );
     println!(
-        "  {:<24} {:>14} {:>14} {:>12} {:>18}",
-        "structure", "segments/ray", "rays/s", "tightness", "tightness vs (a)"
+        "  {:<24} {:>13} {:>12} {:>14} {:>9} {:>16} {:>9}",
+        "structure", "segments/ray", "rays/s", "tightness", "vs (a)", "pooled tightness", "vs (a)"
     );
     for r in &reports {
         println!(
-            "  {:<24} {:>14.2} {:>14.0} {:>12.3} {:>17.1}x",
+            "  {:<24} {:>13.2} {:>12.0} {:>14.2} {:>8.1}x {:>16.3} {:>8.1}x",
             r.name,
             r.segments_per_ray,
             r.rays_per_second,
             r.tightness,
-            reports[0].tightness / r.tightness
+            reports[0].tightness / r.tightness,
+            r.pooled_tightness,
+            reports[0].pooled_tightness / r.pooled_tightness
         );
     }
+    println!("  (tightness: mean over rays of integral(majorant) / integral(density), 1 is the limit;");
+    println!("   pooled: the ratio of the sums, which grazing rays do not dominate)");
     // Density lookups: trilinear at points along the same rays.
     let points: Vec<glam::Vec3> = rays
         .iter()
