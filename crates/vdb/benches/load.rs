@@ -31,8 +31,15 @@ fn large_file() -> PathBuf {
     let path = root.join("target/large.vdb");
     if !path.exists() {
         eprintln!("making {} with tools/make_large.py ...", path.display());
-        let ok = Command::new("/usr/bin/python3").arg(root.join("tools/make_large.py")).arg(&path).status().is_ok_and(|s| s.success());
-        assert!(ok, "tools/make_large.py failed (it needs Debian's python3-openvdb)");
+        let ok = Command::new("/usr/bin/python3")
+            .arg(root.join("tools/make_large.py"))
+            .arg(&path)
+            .status()
+            .is_ok_and(|s| s.success());
+        assert!(
+            ok,
+            "tools/make_large.py failed (it needs Debian's python3-openvdb)"
+        );
     }
     path
 }
@@ -52,20 +59,42 @@ fn main() {
     let ours_stats = best_of(|| {
         let f = cirrus_vdb::VolumeFile::open(&path).unwrap();
         let g = f.read_grid(index).unwrap();
-        std::hint::black_box((g.tree.active_voxel_count(), g.tree.value_range(), g.tree.active_bbox()));
+        std::hint::black_box((
+            g.tree.active_voxel_count(),
+            g.tree.value_range(),
+            g.tree.active_bbox(),
+        ));
     });
     let vdb_print = best_of(|| {
-        let out = Command::new("vdb_print").arg("-l").arg(&path).output().expect("vdb_print (apt install libopenvdb-tools)");
+        let out = Command::new("vdb_print")
+            .arg("-l")
+            .arg(&path)
+            .output()
+            .expect("vdb_print (apt install libopenvdb-tools)");
         assert!(out.status.success());
     });
     let vdb_rs = best_of(|| {
-        let mut r = vdb_rs::VdbReader::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap())).unwrap();
+        let mut r =
+            vdb_rs::VdbReader::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()))
+                .unwrap();
         let g = r.read_grid::<f32>(&name).unwrap();
         std::hint::black_box(g.iter().count());
     });
-    println!("file {} ({} MB, {} active voxels, {} threads)", path.display(), std::fs::metadata(&path).unwrap().len() / 1_000_000, voxels, rayon::current_num_threads());
+    println!(
+        "file {} ({} MB, {} active voxels, {} threads)",
+        path.display(),
+        std::fs::metadata(&path).unwrap().len() / 1_000_000,
+        voxels,
+        rayon::current_num_threads()
+    );
     println!("  cirrus load                 {ours:.3} s");
-    println!("  cirrus load + stats         {ours_stats:.3} s  = {:.2} x vdb_print -l", ours_stats / vdb_print);
+    println!(
+        "  cirrus load + stats         {ours_stats:.3} s  = {:.2} x vdb_print -l",
+        ours_stats / vdb_print
+    );
     println!("  vdb_print -l                {vdb_print:.3} s");
-    println!("  vdb-rs load + iterate       {vdb_rs:.3} s  -> cirrus is {:.2} x faster", vdb_rs / ours_stats);
+    println!(
+        "  vdb-rs load + iterate       {vdb_rs:.3} s  -> cirrus is {:.2} x faster",
+        vdb_rs / ours_stats
+    );
 }

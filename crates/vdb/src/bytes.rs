@@ -32,14 +32,6 @@ impl<'a> ByteCursor<'a> {
         self.base + self.pos as u64
     }
 
-    pub fn seek(&mut self, pos: usize, what: &'static str) -> KindResult<()> {
-        if pos > self.data.len() {
-            return Err(self.truncated(what, pos.saturating_sub(self.pos) as u64));
-        }
-        self.pos = pos;
-        Ok(())
-    }
-
     fn truncated(&self, what: &'static str, needed: u64) -> ErrorKind {
         ErrorKind::Truncated {
             what,
@@ -83,17 +75,11 @@ impl<'a> ByteCursor<'a> {
     pub fn u8(&mut self, what: &'static str) -> KindResult<u8> {
         Ok(self.array::<1>(what)?[0])
     }
-    pub fn u16(&mut self, what: &'static str) -> KindResult<u16> {
-        Ok(u16::from_le_bytes(self.array(what)?))
-    }
     pub fn u32(&mut self, what: &'static str) -> KindResult<u32> {
         Ok(u32::from_le_bytes(self.array(what)?))
     }
     pub fn i32(&mut self, what: &'static str) -> KindResult<i32> {
         Ok(i32::from_le_bytes(self.array(what)?))
-    }
-    pub fn u64(&mut self, what: &'static str) -> KindResult<u64> {
-        Ok(u64::from_le_bytes(self.array(what)?))
     }
     pub fn i64(&mut self, what: &'static str) -> KindResult<i64> {
         Ok(i64::from_le_bytes(self.array(what)?))

@@ -96,6 +96,14 @@ impl VolumeFile {
         }
     }
 
+    /// The OpenVDB library version that wrote the file, or `None` for NanoVDB.
+    pub fn library_version(&self) -> Option<(u32, u32)> {
+        match &self.index {
+            Index::OpenVdb(a) => Some(a.library_version),
+            Index::NanoVdb(_) => None,
+        }
+    }
+
     /// Bytes read from disk since the file was opened.
     pub fn bytes_read(&self) -> u64 {
         self.source.bytes_read()

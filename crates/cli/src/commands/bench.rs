@@ -130,7 +130,9 @@ fn traverse(args: &TraverseArgs) -> CliResult {
             reports[0].pooled_tightness / r.pooled_tightness
         );
     }
-    println!("  (tightness: mean over rays of integral(majorant) / integral(density), 1 is the limit;");
+    println!(
+        "  (tightness: mean over rays of integral(majorant) / integral(density), 1 is the limit;"
+    );
     println!("   pooled: the ratio of the sums, which grazing rays do not dominate)");
     // Density lookups: trilinear at points along the same rays.
     let points: Vec<glam::Vec3> = rays

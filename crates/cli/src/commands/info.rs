@@ -33,6 +33,7 @@ pub fn run(args: &InfoArgs) -> CliResult {
         "file": args.file.display().to_string(),
         "format": file.format().name(),
         "file_version": file.file_version(),
+        "library_version": file.library_version().map(|(a, b)| format!("{a}.{b}")),
         "metadata": metadata_json(file.metadata()),
         "grids": grids,
     });

@@ -20,23 +20,25 @@
 //! upper and lower internal nodes and leaves, found through byte offsets;
 //! `grid.rs` decodes it and `layout.rs` holds the offsets per grid type.
 //!
-//! Versions. NanoVDB's ABI, and so its file layout, is tied to the major
-//! version: every 32.x writer uses the same `FileHeader`, `FileMetaData` and
-//! node layouts, and NanoVDB itself reads any 32.x file (`Version::isCompatible`
-//! compares only the major number). What changed across 32.x is the file
-//! magic: 32.4 and 32.5 write "NanoVDB0"; 32.6 and later write "NanoVDB0" or,
-//! built with `NANOVDB_USE_NEW_MAGIC_NUMBERS`, "NanoVDB2" for segments and
-//! "NanoVDB1" for grid buffers, and can also write raw grid buffers as files.
-//! All of these are read. Other major versions (pre-32 files also start with
-//! "NanoVDB0") are refused as unsupported, naming the version.
+//! Versions. NanoVDB ties its ABI, and so its file layout, to the major
+//! version, and reads any 32.x file (`Version::isCompatible` compares only the
+//! major number); this reader does the same. Within 32.x what changed is the
+//! magic: writers before 32.6 use "NanoVDB0" for segments and grids; 32.6 and
+//! later use "NanoVDB0" too or, built with `NANOVDB_USE_NEW_MAGIC_NUMBERS`,
+//! "NanoVDB2" for segments and "NanoVDB1" for grids, and can also write raw
+//! grid buffers as files. All of these are read. Other major versions (29.x
+//! and other pre-32 files also start with "NanoVDB0", with another layout) are
+//! refused as unsupported, naming the version.
 //!
 //! Verified against: the NanoVDB 32.4.2 headers installed by Debian
-//! (`NanoVDB.h`, `util/IO.h`; struct offsets checked with `offsetof`), files
-//! written by its `nanovdb_convert` and `io::writeGrids` (see the tests and
-//! `tests/fixtures/README.md`), and the 32.6+/32.7 definitions of
-//! `FileHeader`, `FileMetaData` and the raw-buffer reader in the OpenVDB
-//! repository (`nanovdb/nanovdb/NanoVDB.h`, `nanovdb/nanovdb/io/IO.h`), whose
-//! node layout tables (`PNanoVDB.h`) equal 32.4.2's.
+//! (`NanoVDB.h`, `util/IO.h`; struct offsets printed with `offsetof`), files
+//! written by its `nanovdb_convert` and `io::writeGrids` and values read by
+//! its accessor (tests/fixtures/README.md), and the published newer
+//! definitions in the OpenVDB repository: `FileHeader`, `FileMetaData` and the
+//! raw-buffer reader of 32.7 (`nanovdb/nanovdb/NanoVDB.h`, `io/IO.h`), and the
+//! node offset tables of `PNanoVDB.h` 32.9, equal to 32.4.2's for every type
+//! read here. No 32.6+ writer was run: the "NanoVDB2"/"NanoVDB1" and raw-buffer
+//! tests rewrite 32.4.2 files into those layouts.
 //!
 //! Grid types read: Float, Double, Int32, Int64, Vec3f, Vec3d, Boolean, Mask,
 //! and the quantised Fp4, Fp8, Fp16 and FpN (widened to f32, `half_float`
@@ -45,6 +47,7 @@
 
 mod grid;
 mod layout;
+mod walk;
 
 use crate::error::{corrupt, unsupported, ErrorKind, KindResult};
 use crate::grid::{Grid, GridInfo};
@@ -135,16 +138,21 @@ impl NanoIndex {
             let segment_version = word(8).unwrap_or(0);
             let grid_version = word(16).unwrap_or(0);
             // "NanoVDB0" starts both segments and raw grids: a segment has its
-            // version at byte 8, a grid at byte 16 (after its checksum).
+            // version at byte 8 and its codec at 14, a grid has its checksum at
+            // 8..16 and its version at 16. Should both versions read as 32.x,
+            // a codec that no writer uses says the bytes are a checksum.
             let grid_magic = magic == b"NanoVDB1";
             let version = if grid_magic {
                 grid_version
             } else {
                 segment_version
             };
-            if !grid_magic && version_parts(segment_version).0 == 32 {
+            let codec = u16::from_le_bytes([head[14], head[15]]);
+            let segment = !grid_magic && version_parts(segment_version).0 == 32;
+            let raw = magic != b"NanoVDB2" && version_parts(grid_version).0 == 32;
+            if segment && (!raw || codec < 3) {
                 pos = read_segment(src, pos, &mut grids, &mut locs)?;
-            } else if magic != b"NanoVDB2" && version_parts(grid_version).0 == 32 {
+            } else if raw {
                 pos = read_raw_grid(src, pos, &mut grids, &mut locs)?;
             } else {
                 return Err(unsupported(format!(

@@ -12,7 +12,10 @@ pub const COMPRESS_ACTIVE_MASK: u32 = 0x2;
 pub const COMPRESS_BLOSC: u32 = 0x4;
 
 /// The per-node byte that says how inactive values were stored
-/// (io/Compression.h, `readCompressedValues`).
+/// (io/Compression.h, `readCompressedValues`). All seven are listed; mode 1
+/// needs no branch of its own (its inactive value, -background, is the
+/// default for every mode but 0).
+#[allow(dead_code)]
 mod mode {
     pub const NO_MASK_OR_INACTIVE_VALS: u8 = 0;
     pub const NO_MASK_AND_MINUS_BG: u8 = 1;

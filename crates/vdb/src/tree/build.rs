@@ -52,12 +52,6 @@ impl<V: Value> Tree<V> {
         self.leaves.push(node);
         (self.leaves.len() - 1) as u32
     }
-    pub(crate) fn upper_mut(&mut self, i: u32) -> &mut UpperNode<V> {
-        &mut self.upper[i as usize]
-    }
-    pub(crate) fn lower_mut(&mut self, i: u32) -> &mut LowerNode<V> {
-        &mut self.lower[i as usize]
-    }
     pub(crate) fn leaves_mut(&mut self) -> &mut [LeafNode<V>] {
         &mut self.leaves
     }

@@ -94,9 +94,9 @@ impl<V: Value> Tree<V> {
                     })
                 }
                 Some(r) => {
-                    for i in 0..k {
-                        r.min[i] = r.min[i].min(c[i]);
-                        r.max[i] = r.max[i].max(c[i]);
+                    for (i, &x) in c.iter().enumerate().take(k) {
+                        r.min[i] = r.min[i].min(x);
+                        r.max[i] = r.max[i].max(x);
                     }
                 }
             }
