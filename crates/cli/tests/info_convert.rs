@@ -1,0 +1,138 @@
+//! The `cirrus` binary end to end: `info --json` against the manifest the
+//! Debian tools wrote, `convert` and `info` of the result, and bad input.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn cirrus(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_cirrus"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn info_json_agrees_with_the_manifest() {
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(root().join("data/manifest.json")).unwrap())
+            .unwrap();
+    let mut compared = 0;
+    for name in [
+        "cloud.vdb",
+        "multi_grid.vdb",
+        "leaf_tiles.vdb",
+        "sphere_fog.nvdb",
+        "empty_grid.vdb",
+    ] {
+        let entry = manifest["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|f| f["file"] == name)
+            .unwrap();
+        let (ok, stdout, stderr) = cirrus(&["info", &format!("data/{name}"), "--json"]);
+        assert!(ok, "{name}: {stderr}");
+        let info: Value = serde_json::from_str(&stdout).unwrap();
+        assert_eq!(info["format"], entry["format"], "{name}");
+        let grids = info["grids"].as_array().unwrap();
+        for (ours, theirs) in grids.iter().zip(entry["grids"].as_array().unwrap()) {
+            for key in [
+                "name",
+                "active_voxels",
+                "leaf_count",
+                "index_bbox",
+                "value_type",
+                "class",
+            ] {
+                assert_eq!(ours[key], theirs[key], "{name} {key}");
+            }
+            let tiles: u64 = theirs["active_tile_count"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|t| t.as_u64().unwrap())
+                .sum();
+            assert_eq!(
+                ours["tile_count"].as_u64(),
+                Some(tiles),
+                "{name} tile_count"
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared >= 8);
+}
+
+#[test]
+fn convert_writes_a_cbrk_that_info_reads() {
+    let out = std::env::temp_dir().join(format!("cirrus-cli-{}.cbrk", std::process::id()));
+    let out_s = out.to_str().unwrap();
+    let (ok, _, stderr) = cirrus(&[
+        "convert",
+        "data/multi_grid.vdb",
+        "--grid",
+        "density",
+        "--precision",
+        "u8",
+        "-o",
+        out_s,
+    ]);
+    assert!(ok, "{stderr}");
+    let (ok, stdout, stderr) = cirrus(&["info", out_s, "--json"]);
+    assert!(ok, "{stderr}");
+    let info: Value = serde_json::from_str(&stdout).unwrap();
+    std::fs::remove_file(&out).unwrap();
+    assert_eq!(info["precision"], "u8");
+    assert_eq!(info["grid"], "density");
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(root().join("data/manifest.json")).unwrap())
+            .unwrap();
+    let entry = manifest["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["file"] == "multi_grid.vdb")
+        .unwrap();
+    let density = entry["grids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|g| g["name"] == "density")
+        .unwrap();
+    assert_eq!(info["active_voxels"], density["active_voxels"]);
+    let stored = info["bricks_stored"].as_u64().unwrap();
+    assert!(stored > 0 && stored <= density["leaf_count"].as_u64().unwrap());
+}
+
+#[test]
+fn bad_input_is_a_clear_error_naming_the_file() {
+    let (ok, _, stderr) = cirrus(&["info", "data/manifest.json"]);
+    assert!(
+        !ok && stderr.contains("manifest.json")
+            && stderr.contains("not an OpenVDB or NanoVDB file"),
+        "{stderr}"
+    );
+    let (ok, _, stderr) = cirrus(&["info", "data/no_such_file.vdb"]);
+    assert!(!ok && stderr.contains("no_such_file.vdb"), "{stderr}");
+    let (ok, _, stderr) = cirrus(&[
+        "convert",
+        "data/level_set_sphere.vdb",
+        "-o",
+        "/tmp/never.cbrk",
+    ]);
+    assert!(!ok && stderr.contains("level set"), "{stderr}");
+    assert!(!Path::new("/tmp/never.cbrk").exists());
+    let (ok, _, stderr) = cirrus(&["info", "data/multi_grid.vdb", "--json", "--no-such-flag"]);
+    assert!(!ok && stderr.contains("--no-such-flag"), "{stderr}");
+}
