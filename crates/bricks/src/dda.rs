@@ -50,6 +50,10 @@ pub struct SegmentIter<'a> {
     pending: Option<RaySegment>,
     /// Pyramid steps taken (cells visited), for statistics.
     pub steps: u32,
+    /// Level of the last cell visited.
+    level: usize,
+    /// Absolute part of the nudge: 1e-5 voxels along the ray's major axis.
+    nudge_abs: f32,
 }
 
 /// Slab test of a ray against the box [lo, hi]: the parameter interval inside.
@@ -66,6 +70,8 @@ impl<'a> SegmentIter<'a> {
     pub fn new(volume: &'a BrickVolume, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
         let inv_dir = dir.recip();
         let (b0, b1) = ray_box(origin, inv_dir, Vec3::ZERO, volume.local_extent());
+        // For exits: a zero component never exits (+inf, whatever the sign of zero).
+        let inv_dir = Vec3::select(dir.cmpeq(Vec3::ZERO), Vec3::INFINITY, inv_dir);
         let valid = origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO;
         let (t, t_end) = if valid {
             (t_min.max(b0), t_max.min(b1))
@@ -81,43 +87,53 @@ impl<'a> SegmentIter<'a> {
             t_end,
             pending: None,
             steps: 0,
+            level: 0,
+            nudge_abs: 1e-5 / dir.abs().max_element(),
         }
     }
 
     /// The next raw (unmerged) segment, or `None` at the end of the ray.
     fn step(&mut self) -> Option<RaySegment> {
         let levels = &self.volume.levels;
+        let top = levels.len().saturating_sub(1);
         while self.t < self.t_end {
             self.steps += 1;
-            let nudge = self.t.abs() * 1e-6 + 1e-5 / self.dir.abs().max_element();
+            let nudge = self.t.abs() * 1e-6 + self.nudge_abs;
             let p = self.origin + self.dir * (self.t + nudge);
             let voxel = p.floor().as_ivec3();
-            // From the coarsest level down to the first non-empty, non-uniform.
-            let mut emit = None;
-            let mut exit_level = 0;
-            for (l, level) in levels.iter().enumerate().rev() {
-                let cell = voxel >> (CELL_LOG2 + l as u32) as i32;
-                let (lo, hi) = level.get(cell.to_array());
-                if hi <= 0.0 || lo >= hi * TIGHT_ENOUGH || l == 0 {
-                    exit_level = l;
-                    if hi > 0.0 {
-                        emit = Some((lo, hi));
-                    }
-                    break;
-                }
+            let bounds_at =
+                |l: usize| levels[l].get((voxel >> (CELL_LOG2 + l as u32) as i32).to_array());
+            // Start one level above where the last step ended: climb while the
+            // parent is empty (to skip empty space at the coarsest level),
+            // then descend to the first cell that is empty, tight enough, or
+            // finest. Starting low only ever gives finer (still valid) cells.
+            let mut l = (self.level + 1).min(top);
+            while l < top && bounds_at(l + 1).1 <= 0.0 {
+                l += 1;
             }
-            let size = (1i32 << (CELL_LOG2 + exit_level as u32)) as f32;
-            let cell_lo = (voxel >> (CELL_LOG2 + exit_level as u32) as i32).as_vec3() * size;
-            let (_, exit) = ray_box(self.origin, self.inv_dir, cell_lo, cell_lo + size);
+            let (lo, hi) = loop {
+                let (lo, hi) = bounds_at(l);
+                if hi <= 0.0 || lo >= hi * TIGHT_ENOUGH || l == 0 {
+                    break (lo, hi);
+                }
+                l -= 1;
+            };
+            self.level = l;
+            // Exit through the cell's far faces (the near ones are behind us).
+            let size = (1i32 << (CELL_LOG2 + l as u32)) as f32;
+            let cell_lo = (voxel >> (CELL_LOG2 + l as u32) as i32).as_vec3() * size;
+            let far =
+                cell_lo + Vec3::select(self.dir.cmpge(Vec3::ZERO), Vec3::splat(size), Vec3::ZERO);
+            let exit = ((far - self.origin) * self.inv_dir).min_element();
             let t0 = self.t;
             let t1 = exit.max(t0 + nudge).min(self.t_end);
             self.t = t1;
-            if let Some((minorant, majorant)) = emit {
+            if hi > 0.0 {
                 return Some(RaySegment {
                     t0,
                     t1,
-                    minorant,
-                    majorant,
+                    minorant: lo,
+                    majorant: hi,
                 });
             }
         }

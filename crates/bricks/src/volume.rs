@@ -101,7 +101,7 @@ impl BrickVolume {
         DMat4::from_translation(-self.origin.as_dvec3()) * self.index_to_world.inverse()
     }
 
-    #[inline]
+    #[inline(always)]
     pub(crate) fn brick_ref(&self, b: IVec3) -> BrickRef {
         if b.x < 0
             || b.y < 0
@@ -118,7 +118,7 @@ impl BrickVolume {
     }
 
     /// Value of voxel `n` of stored brick `b`.
-    #[inline]
+    #[inline(always)]
     fn stored(&self, b: u32, n: usize) -> f32 {
         let i = b as usize * 512 + n;
         match &self.atlas {
@@ -127,6 +127,39 @@ impl BrickVolume {
             Atlas::U8(a) => {
                 let (lo, step) = (self.ranges[2 * b as usize], self.ranges[2 * b as usize + 1]);
                 lo + a[i] as f32 * step
+            }
+        }
+    }
+
+    /// The eight voxels `n + {0, 1, 8, 9, 64, 65, 72, 73}` of stored brick
+    /// `b` (a trilinear stencil inside one brick), decoding the atlas once.
+    #[inline(always)]
+    fn stored_corners(&self, b: u32, n: usize) -> [f32; 8] {
+        // One slice per stencil: a single bounds check covers all eight reads.
+        macro_rules! gather {
+            ($s:expr, $f:expr) => {{
+                let s = $s;
+                let f = $f;
+                [
+                    f(s[0]),
+                    f(s[1]),
+                    f(s[8]),
+                    f(s[9]),
+                    f(s[64]),
+                    f(s[65]),
+                    f(s[72]),
+                    f(s[73]),
+                ]
+            }};
+        }
+        let base = b as usize * 512 + n;
+        match &self.atlas {
+            Atlas::F32(a) => gather!(&a[base..base + 74], |v: f32| v),
+            Atlas::F16(a) => gather!(&a[base..base + 74], |v: u16| half::f16::from_bits(v)
+                .to_f32()),
+            Atlas::U8(a) => {
+                let (lo, step) = (self.ranges[2 * b as usize], self.ranges[2 * b as usize + 1]);
+                gather!(&a[base..base + 74], |v: u8| lo + v as f32 * step)
             }
         }
     }
@@ -162,10 +195,7 @@ impl BrickVolume {
             match self.brick_ref(c >> BRICK_LOG2 as i32) {
                 BrickRef::Empty => return 0.0,
                 BrickRef::Constant(k) => return self.constants[k as usize],
-                BrickRef::Stored(b) => {
-                    let n = voxel_offset(c.x, c.y, c.z);
-                    [0, 1, 8, 9, 64, 65, 72, 73].map(|d| self.stored(b, n + d))
-                }
+                BrickRef::Stored(b) => self.stored_corners(b, voxel_offset(c.x, c.y, c.z)),
             }
         } else {
             let at = |dx, dy, dz| self.voxel(c + IVec3::new(dx, dy, dz));

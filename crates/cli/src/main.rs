@@ -25,6 +25,8 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Convert a float grid into sparse bricks (.cbrk).
     Convert(commands::convert::ConvertArgs),
+    /// Render a volume to EXR (and PNG).
+    Render(Box<commands::render::RenderArgs>),
     /// Benchmarks that print figures.
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -36,6 +38,7 @@ fn main() -> ExitCode {
         Command::Info(args) => commands::info::run(&args),
         Command::Convert(args) => commands::convert::run(&args),
         Command::Bench(cmd) => commands::bench::run(&cmd),
+        Command::Render(args) => commands::render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

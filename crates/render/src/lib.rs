@@ -1,1 +1,59 @@
-//! placeholder
+//! The cirrus renderer: physically based images of sparse density fields
+//! (OpenVDB clouds), plus the biased baselines they are measured against.
+//!
+//! How the parts fit:
+//!
+//! - [`medium`] defines [`DensityField`], the one interface to a volume: point
+//!   lookups and, along a ray, front-to-back [`MajorantSegment`]s bounding
+//!   the density. The brick volumes implement it elsewhere; here live the test
+//!   fields ([`ConstantBox`], [`GridField`] with its DDA-walked
+//!   [`MajorantGrid`]) and the [`GlobalMajorant`] wrapper. A [`Medium`] adds
+//!   density scale, albedo and the [`HenyeyGreenstein`] phase function.
+//! - [`tracking`] turns segments into events: delta-tracked free flights and
+//!   ratio, residual-ratio and track-length transmittance, each with a
+//!   collision cap and Russian roulette.
+//! - [`integrator`] turns a camera ray into a [`Sample`]: the unbiased
+//!   [`PathTracer`], the single-scattering [`RayMarcher`], and the two-pass
+//!   [`TwoPassMarcher`] over a cached [`LightGrid`].
+//! - [`render()`] runs an integrator over tiles on rayon into a film of
+//!   per-pixel means and variances, for a sample count or a time budget,
+//!   and returns the [`Image`] with [`RenderStats`]. [`image_io`] writes EXR
+//!   and PNG files atomically.
+//! - [`Camera`], [`light`] (sun and environment) and the counter-based
+//!   [`Rng`] in [`sampling`] are the supporting pieces. The RNG is keyed by
+//!   (seed, pixel, sample), which makes images independent of thread count.
+//!
+//! Coordinates are render space: world space minus an offset the caller
+//! picks so that f32 stays precise; lengths keep world units.
+
+pub mod camera;
+pub mod film;
+pub mod image_io;
+pub mod integrator;
+pub mod light;
+pub mod medium;
+pub mod phase;
+pub mod ray;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+pub mod stats;
+pub mod tracking;
+
+pub use camera::Camera;
+pub use film::Image;
+pub use integrator::{
+    CameraSampler, IntegratorKind, LightGrid, LightGridSettings, PathTracer, RayMarcher, Sample,
+    TwoPassMarcher,
+};
+pub use light::{Environment, Lights, Sun};
+pub use medium::{
+    ConstantBox, DensityField, GlobalMajorant, GridField, MajorantGrid, MajorantSegment, Medium,
+};
+pub use phase::HenyeyGreenstein;
+pub use ray::Ray;
+pub use render::{render, Rendered};
+pub use sampling::Rng;
+pub use scene::{Budget, MajorantMode, RenderSettings, Scene};
+pub use stats::{Counters, RenderStats};
+pub use tracking::TransmittanceEstimator;

@@ -1,0 +1,122 @@
+//! A pinhole camera.
+
+use glam::Vec3;
+
+use crate::ray::Ray;
+
+/// A pinhole camera at `from` looking at `to`; pixel `(0, 0)` is the top-left
+/// corner of the image and `y` grows downward.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    from: Vec3,
+    to: Vec3,
+    up: Vec3,
+    vfov_degrees: f32,
+    width: u32,
+    height: u32,
+    // Derived frame, hence the private fields.
+    forward: Vec3,
+    right: Vec3,
+    true_up: Vec3,
+    tan_half: f32,
+}
+
+impl Camera {
+    pub fn new(from: Vec3, to: Vec3, up: Vec3, vfov_degrees: f32, width: u32, height: u32) -> Self {
+        let forward = (to - from).normalize();
+        // Fall back to another up vector when looking straight along `up`.
+        let mut right = forward.cross(up);
+        if right.length_squared() < 1e-12 {
+            right = forward.cross(forward.any_orthonormal_vector());
+        }
+        let right = right.normalize();
+        let true_up = right.cross(forward);
+        Self {
+            from,
+            to,
+            up,
+            vfov_degrees,
+            width: width.max(1),
+            height: height.max(1),
+            forward,
+            right,
+            true_up,
+            tan_half: (0.5 * vfov_degrees.to_radians()).tan(),
+        }
+    }
+
+    /// Frames the box `[lo, hi]` from a three-quarter view above and to the
+    /// side (azimuth 40 degrees, elevation 20 degrees, +Y up as in most VDB
+    /// clouds), at the smallest distance from which all eight corners fall
+    /// inside the frame, plus a 5% margin.
+    pub fn framing(bounds: (Vec3, Vec3), width: u32, height: u32) -> Self {
+        const VFOV: f32 = 35.0;
+        const MARGIN: f32 = 1.05;
+        let (lo, hi) = bounds;
+        let centre = 0.5 * (lo + hi);
+        let (az, el) = (40f32.to_radians(), 20f32.to_radians());
+        let view = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
+        let aspect = width.max(1) as f32 / height.max(1) as f32;
+        let tan_v = (0.5 * VFOV.to_radians()).tan() / MARGIN;
+        let tan_h = tan_v * aspect;
+        // Camera at centre + D view looking along -view: a corner at offset
+        // c has depth D - c.view and must satisfy |c.right| <= tan_h depth
+        // and |c.up| <= tan_v depth.
+        let forward = -view;
+        let right = forward.cross(Vec3::Y).normalize();
+        let up = right.cross(forward);
+        let mut distance = 1e-6f32;
+        for i in 0..8 {
+            let corner = Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let c = corner - centre;
+            let need = (c.dot(right).abs() / tan_h).max(c.dot(up).abs() / tan_v) + c.dot(view);
+            distance = distance.max(need);
+        }
+        Self::new(
+            centre + distance * view,
+            centre,
+            Vec3::Y,
+            VFOV,
+            width,
+            height,
+        )
+    }
+
+    pub fn from(&self) -> Vec3 {
+        self.from
+    }
+    pub fn to(&self) -> Vec3 {
+        self.to
+    }
+    pub fn up(&self) -> Vec3 {
+        self.up
+    }
+    /// Vertical field of view in degrees.
+    pub fn vfov_degrees(&self) -> f32 {
+        self.vfov_degrees
+    }
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// The ray through the film position `(px, py)` in pixel units
+    /// (`(x + 0.5, y + 0.5)` is pixel `(x, y)`'s centre); unit direction.
+    #[inline]
+    pub fn ray(&self, px: f32, py: f32) -> Ray {
+        let sx = (2.0 * px / self.width as f32 - 1.0) * self.tan_half * self.aspect();
+        let sy = (1.0 - 2.0 * py / self.height as f32) * self.tan_half;
+        let dir = (self.forward + sx * self.right + sy * self.true_up).normalize();
+        Ray::new(self.from, dir)
+    }
+}

@@ -1,0 +1,262 @@
+//! Pass one of Kajiya and Von Herzen (1984): the direct light at every point
+//! of a lattice over the field, stored sparsely in bricks.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::march::{marched_transmittance, MIN_STEP_VOXELS};
+use crate::light::Lights;
+use crate::medium::{DensityField, Medium};
+use crate::sampling::{from_local, Rng};
+use crate::stats::Counters;
+
+/// Lattice points per brick edge.
+const BRICK: usize = 8;
+const BRICK_POINTS: usize = BRICK * BRICK * BRICK;
+/// Keeps the light grid's random streams apart from the camera samples'.
+const GRID_DOMAIN: u64 = 0x4c49_4748_5447_5244;
+
+/// Resolution and quality of the two-pass light grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightGridSettings {
+    /// Lattice spacing in voxels.
+    pub cell_voxels: f32,
+    /// Marched directions per lattice point for the environment term.
+    pub env_directions: u32,
+}
+
+impl Default for LightGridSettings {
+    fn default() -> Self {
+        Self {
+            cell_voxels: 4.0,
+            env_directions: 8,
+        }
+    }
+}
+
+/// What is stored per lattice point: the sun's transmittance, and the first
+/// two spherical-harmonic bands of the environment's transmittance
+/// `T(p, w)`, as `a = mean of T` and `b = mean of T w` over the sphere.
+///
+/// Kajiya and Von Herzen expanded the light field in spherical harmonics;
+/// bands 0 and 1 are enough here because HG's harmonic coefficients are
+/// `g^l` (Funk-Hecke), so the in-scattered environment light toward a ray
+/// travelling along `d` is `L_env * (a + 3 g b . d)`: exact for g = 0 and
+/// missing only the `g^2` and higher terms otherwise.
+type Entry = [f32; 4 + 1];
+
+/// Sparse lattice of direct light over the field's bounds.
+///
+/// Built at a chosen spacing; bricks of 8^3 lattice points are stored only
+/// when the density is non-zero at a lattice point or cell centre in or
+/// around them. Lookups elsewhere return no light, so features smaller than a
+/// cell can be missed: the price of the baseline.
+pub struct LightGrid {
+    lo: Vec3,
+    cell: f32,
+    points: [usize; 3],
+    bricks: [usize; 3],
+    /// Per brick, its 8^3 entries (x fastest), or `None` where empty.
+    brick_data: Vec<Option<Box<[Entry]>>>,
+}
+
+impl LightGrid {
+    /// Pass one: marches shadow rays from every lattice point of the
+    /// non-empty bricks (in parallel; each point has its own random stream,
+    /// so the grid is the same for any thread count). A sun with a disc is
+    /// treated as a point at its centre here.
+    pub fn build<F: DensityField>(
+        medium: &Medium<F>,
+        lights: &Lights,
+        step_voxels: f32,
+        settings: &LightGridSettings,
+        seed: u64,
+        c: &mut Counters,
+    ) -> Self {
+        let lights = lights.pruned();
+        let voxel = medium.field.voxel_size();
+        let cell = settings.cell_voxels.max(MIN_STEP_VOXELS) * voxel;
+        let step = step_voxels.max(MIN_STEP_VOXELS) * voxel;
+        let (lo, hi) = medium.field.bounds();
+        let extent = (hi - lo).max(Vec3::ZERO);
+        let points = [0, 1, 2].map(|a| (extent[a] / cell).ceil() as usize + 1);
+        let bricks = points.map(|n| n.div_ceil(BRICK));
+        let mut grid = Self {
+            lo,
+            cell,
+            points,
+            bricks,
+            brick_data: Vec::new(),
+        };
+        let n_bricks = bricks.iter().product::<usize>();
+        let env_dirs = settings.env_directions.max(1);
+        let built: Vec<(Option<Box<[Entry]>>, Counters)> = (0..n_bricks)
+            .into_par_iter()
+            .map(|b| {
+                let mut bc = Counters::default();
+                let origin = grid.brick_origin(b);
+                let data = grid.brick_occupied(medium, origin, &mut bc).then(|| {
+                    let mut out = vec![[0.0; 5]; BRICK_POINTS];
+                    for (local, entry) in out.iter_mut().enumerate() {
+                        let ijk = [
+                            local % BRICK,
+                            (local / BRICK) % BRICK,
+                            local / (BRICK * BRICK),
+                        ];
+                        let q = [0, 1, 2].map(|a| origin[a] + ijk[a]);
+                        if q.iter().zip(&points).any(|(i, n)| i >= n) {
+                            continue;
+                        }
+                        let index = q[0] + points[0] * (q[1] + points[1] * q[2]);
+                        let mut rng = Rng::new(seed ^ GRID_DOMAIN, index as u64, 0);
+                        *entry =
+                            grid.light_at(medium, &lights, q, step, env_dirs, &mut rng, &mut bc);
+                    }
+                    out.into_boxed_slice()
+                });
+                (data, bc)
+            })
+            .collect();
+        grid.brick_data = built
+            .into_iter()
+            .map(|(data, bc)| {
+                *c += bc;
+                data
+            })
+            .collect();
+        grid
+    }
+
+    /// Number of bricks holding light (for reporting sparsity); each
+    /// costs 8^3 entries of 20 bytes.
+    pub fn stored_bricks(&self) -> usize {
+        self.brick_data.iter().filter(|b| b.is_some()).count()
+    }
+
+    /// Number of bricks covering the lattice, stored or not.
+    pub fn total_bricks(&self) -> usize {
+        self.brick_data.len()
+    }
+
+    fn brick_origin(&self, b: usize) -> [usize; 3] {
+        let [bx, by, _] = self.bricks;
+        [b % bx, (b / bx) % by, b / (bx * by)].map(|i| i * BRICK)
+    }
+
+    /// Whether any density lies near the brick: sampled at the lattice
+    /// points one beyond the brick on every side and at the cell centres
+    /// between them.
+    fn brick_occupied<F: DensityField>(
+        &self,
+        medium: &Medium<F>,
+        origin: [usize; 3],
+        c: &mut Counters,
+    ) -> bool {
+        let start = Vec3::new(origin[0] as f32, origin[1] as f32, origin[2] as f32) - 1.0;
+        let n = 2 * (BRICK + 2) - 1; // points and centres at half-cell spacing
+        for k in 0..n {
+            for j in 0..n {
+                for i in 0..n {
+                    let q = start + 0.5 * Vec3::new(i as f32, j as f32, k as f32);
+                    c.density_lookups += 1;
+                    if medium.field.density(self.lo + self.cell * q) > 0.0 {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn light_at<F: DensityField>(
+        &self,
+        medium: &Medium<F>,
+        lights: &Lights,
+        q: [usize; 3],
+        step: f32,
+        env_dirs: u32,
+        rng: &mut Rng,
+        c: &mut Counters,
+    ) -> Entry {
+        let p = self.lo + self.cell * Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32);
+        let mut e = [0.0; 5];
+        if let Some(sun) = &lights.sun {
+            e[0] = marched_transmittance(medium, p, -sun.direction(), step, rng, c);
+        }
+        if lights.environment.is_some() {
+            // Directions stratified in cos(theta), random in phi.
+            let (mut a, mut b) = (0.0, Vec3::ZERO);
+            for s in 0..env_dirs {
+                let z = 1.0 - 2.0 * (s as f32 + rng.uniform()) / env_dirs as f32;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = std::f32::consts::TAU * rng.uniform();
+                let w = from_local(Vec3::Z, r * phi.cos(), r * phi.sin(), z);
+                let tr = marched_transmittance(medium, p, w, step, rng, c);
+                a += tr;
+                b += tr * w;
+            }
+            let inv = 1.0 / env_dirs as f32;
+            e[1] = a * inv;
+            [e[2], e[3], e[4]] = (b * inv).to_array();
+        }
+        e
+    }
+
+    #[inline]
+    fn entry(&self, i: usize, j: usize, k: usize) -> Entry {
+        let bi = i / BRICK + self.bricks[0] * (j / BRICK + self.bricks[1] * (k / BRICK));
+        match &self.brick_data[bi] {
+            None => [0.0; 5],
+            Some(brick) => brick[i % BRICK + BRICK * (j % BRICK + BRICK * (k % BRICK))],
+        }
+    }
+
+    /// Trilinear interpolation of the stored entries at `p` (clamped to
+    /// the lattice).
+    fn lookup(&self, p: Vec3) -> Entry {
+        let x = (p - self.lo) / self.cell;
+        let mut base = [0usize; 3];
+        let mut f = [0f32; 3];
+        for a in 0..3 {
+            let max_base = self.points[a].saturating_sub(2) as f32;
+            let xb = x[a].floor().clamp(0.0, max_base);
+            base[a] = xb as usize;
+            f[a] = (x[a] - xb).clamp(0.0, 1.0);
+        }
+        let mut out = [0.0; 5];
+        for corner in 0..8 {
+            let d = [corner & 1, (corner >> 1) & 1, corner >> 2];
+            let mut w = 1.0;
+            let mut q = [0usize; 3];
+            for a in 0..3 {
+                w *= if d[a] == 1 { f[a] } else { 1.0 - f[a] };
+                q[a] = (base[a] + d[a]).min(self.points[a] - 1);
+            }
+            if w > 0.0 {
+                let e = self.entry(q[0], q[1], q[2]);
+                for (o, v) in out.iter_mut().zip(e) {
+                    *o += w * v;
+                }
+            }
+        }
+        out
+    }
+
+    /// Phase-weighted direct light at `p` toward a ray travelling along
+    /// `dir` (pass two's in-scattering term).
+    pub fn in_scatter<F>(&self, medium: &Medium<F>, lights: &Lights, p: Vec3, dir: Vec3) -> Vec3 {
+        let e = self.lookup(p);
+        let mut s = Vec3::ZERO;
+        if let Some(sun) = &lights.sun {
+            let f = medium.phase.eval(dir, -sun.direction());
+            s += sun.irradiance() * (f * e[0]);
+        }
+        if let Some(env) = &lights.environment {
+            let b = Vec3::new(e[2], e[3], e[4]);
+            let band = e[1] + 3.0 * medium.phase.g() * b.dot(dir);
+            s += env.radiance * band.max(0.0);
+        }
+        s
+    }
+}

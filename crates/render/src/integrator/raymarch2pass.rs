@@ -1,0 +1,53 @@
+//! Pass two of Kajiya and Von Herzen (1984): camera rays marched through the
+//! cached direct light.
+
+use super::light_grid::LightGrid;
+use super::march::{march_camera_ray, MIN_STEP_VOXELS};
+use super::{CameraSampler, Sample};
+use crate::light::Lights;
+use crate::medium::{DensityField, Medium};
+use crate::ray::Ray;
+use crate::sampling::Rng;
+use crate::stats::Counters;
+
+/// Single scattering with the light looked up (trilinearly) in a
+/// [`LightGrid`] built once, instead of a shadow march per step: cost per
+/// camera ray is linear in its steps. Biased by the grid's resolution and
+/// the truncated angular expansion as well as by the step.
+pub struct TwoPassMarcher<'a, F> {
+    medium: &'a Medium<F>,
+    lights: Lights,
+    grid: &'a LightGrid,
+    step: f32,
+}
+
+impl<'a, F: DensityField> TwoPassMarcher<'a, F> {
+    pub fn new(
+        medium: &'a Medium<F>,
+        lights: Lights,
+        grid: &'a LightGrid,
+        step_voxels: f32,
+    ) -> Self {
+        let step = step_voxels.max(MIN_STEP_VOXELS) * medium.field.voxel_size();
+        Self {
+            medium,
+            lights: lights.pruned(),
+            grid,
+            step,
+        }
+    }
+}
+
+impl<F: DensityField> CameraSampler for TwoPassMarcher<'_, F> {
+    fn sample(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
+        march_camera_ray(
+            self.medium,
+            &self.lights,
+            &ray,
+            self.step,
+            rng,
+            c,
+            |p, _, _| self.grid.in_scatter(self.medium, &self.lights, p, ray.dir),
+        )
+    }
+}

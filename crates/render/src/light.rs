@@ -1,0 +1,139 @@
+//! Lights at infinity: a directional sun (optionally a small disc) and a
+//! constant environment. Absent lights are `None` in [`Lights`] and cost
+//! nothing: no samples, no shadow rays.
+
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use crate::sampling::{uniform_cone, uniform_sphere, UNIFORM_SPHERE_PDF};
+
+/// A direction toward a light with the radiance arriving along it and the
+/// solid-angle pdf of having sampled it (`None` for a delta light).
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    pub to_light: Vec3,
+    pub radiance: Vec3,
+    pub pdf: Option<f32>,
+}
+
+/// A directional light like Mitsuba 3's `directional` emitter: `irradiance`
+/// is measured on a plane perpendicular to the light's direction.
+///
+/// With a non-zero angular diameter the sun is a cone of uniform radiance
+/// `irradiance / solid_angle`, so the light it delivers into a medium equals
+/// the delta light's (`integral of L over the cone = irradiance`) and
+/// changing the angle only softens shadows.
+#[derive(Clone, Copy, Debug)]
+pub struct Sun {
+    /// Unit vector pointing FROM the light toward the scene.
+    direction: Vec3,
+    irradiance: Vec3,
+    /// `1 - cos(half angle)`, computed as `2 sin^2(half / 2)` for precision.
+    one_minus_cos: f32,
+    solid_angle: f32,
+}
+
+impl Sun {
+    /// `direction` points from the light toward the scene (normalised here);
+    /// `angular_diameter` is the full apex angle of the disc in radians
+    /// (0 = delta light; the real sun is about 0.0093; up to 2 pi, where the
+    /// "disc" is the whole sphere, which the tests use as a furnace).
+    pub fn new(direction: Vec3, irradiance: Vec3, angular_diameter: f32) -> Self {
+        let half = if angular_diameter.is_nan() {
+            0.0
+        } else {
+            (0.5 * angular_diameter).clamp(0.0, PI)
+        };
+        let one_minus_cos = 2.0 * (0.5 * half).sin().powi(2);
+        Self {
+            direction: direction.normalize(),
+            irradiance,
+            one_minus_cos,
+            solid_angle: 2.0 * PI * one_minus_cos,
+        }
+    }
+
+    pub fn direction(&self) -> Vec3 {
+        self.direction
+    }
+
+    pub fn irradiance(&self) -> Vec3 {
+        self.irradiance
+    }
+
+    /// A delta light cannot be hit by a sampled direction, so it gets
+    /// next-event estimation only and no MIS.
+    pub fn is_delta(&self) -> bool {
+        self.solid_angle <= 0.0
+    }
+
+    /// Samples a direction toward the sun, uniform over its cone.
+    pub fn sample(&self, u1: f32, u2: f32) -> LightSample {
+        if self.is_delta() {
+            return LightSample {
+                to_light: -self.direction,
+                radiance: self.irradiance,
+                pdf: None,
+            };
+        }
+        LightSample {
+            to_light: uniform_cone(-self.direction, self.one_minus_cos, u1, u2),
+            radiance: self.irradiance / self.solid_angle,
+            pdf: Some(1.0 / self.solid_angle),
+        }
+    }
+
+    /// Radiance and sampling pdf seen along `dir` by a ray escaping the
+    /// scene, or `None` outside the disc (always `None` for a delta sun).
+    pub fn hit(&self, dir: Vec3) -> Option<(Vec3, f32)> {
+        if self.is_delta() {
+            return None;
+        }
+        // 1 - cos(angle to the sun's centre) compared in the same form as
+        // the cone was built, so small suns are not lost to rounding.
+        let one_minus_cos = 1.0 + dir.dot(self.direction);
+        (one_minus_cos <= self.one_minus_cos)
+            .then(|| (self.irradiance / self.solid_angle, 1.0 / self.solid_angle))
+    }
+}
+
+/// A constant radiance arriving from every direction.
+#[derive(Clone, Copy, Debug)]
+pub struct Environment {
+    pub radiance: Vec3,
+}
+
+impl Environment {
+    pub fn new(radiance: Vec3) -> Self {
+        Self { radiance }
+    }
+
+    /// Uniform sphere sampling: for a constant environment the only
+    /// light-side strategy there is; MIS with phase sampling adds the rest.
+    pub fn sample(&self, u1: f32, u2: f32) -> LightSample {
+        LightSample {
+            to_light: uniform_sphere(u1, u2),
+            radiance: self.radiance,
+            pdf: Some(UNIFORM_SPHERE_PDF),
+        }
+    }
+}
+
+/// The scene's lights; `None` means absent.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Lights {
+    pub sun: Option<Sun>,
+    pub environment: Option<Environment>,
+}
+
+impl Lights {
+    /// Drops lights that deliver nothing (zero irradiance or radiance), so
+    /// they cost nothing either.
+    pub fn pruned(self) -> Self {
+        Self {
+            sun: self.sun.filter(|s| s.irradiance.max_element() > 0.0),
+            environment: self.environment.filter(|e| e.radiance.max_element() > 0.0),
+        }
+    }
+}

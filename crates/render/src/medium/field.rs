@@ -1,0 +1,68 @@
+//! The abstraction every renderer here is written against: a scalar density
+//! field that can bound itself along a ray.
+
+use glam::Vec3;
+
+/// Over `[t0, t1]` along a ray the (unscaled) density lies within
+/// `[minorant, majorant]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MajorantSegment {
+    pub t0: f32,
+    pub t1: f32,
+    pub minorant: f32,
+    pub majorant: f32,
+}
+
+/// A density field in render space (world space minus an offset chosen by the
+/// caller so coordinates stay small in `f32`).
+///
+/// The trackers only ever need two things from a field: point lookups and,
+/// along a ray, piecewise-constant bounds of the density. How tight those
+/// bounds are is what decides the cost of null-collision tracking.
+pub trait DensityField: Send + Sync {
+    type Segments<'a>: Iterator<Item = MajorantSegment>
+    where
+        Self: 'a;
+
+    /// Render-space bounds of where density may be non-zero.
+    fn bounds(&self) -> (Vec3, Vec3);
+
+    /// Trilinearly interpolated density at a render-space point (0 outside).
+    fn density(&self, p: Vec3) -> f32;
+
+    /// Front-to-back, disjoint majorant segments covering the ray's overlap
+    /// with the field inside `[t_min, t_max]` (gaps mean zero density).
+    /// `dir` need not be normalised; t is in units of `dir`.
+    fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_>;
+
+    /// One majorant for the whole field (for the global-majorant mode).
+    fn global_majorant(&self) -> f32;
+
+    /// Smallest world-space voxel size (ray-march steps are given in voxels).
+    fn voxel_size(&self) -> f32;
+}
+
+/// A borrowed field is a field, so wrappers such as
+/// [`GlobalMajorant`](super::GlobalMajorant) can borrow instead of own.
+impl<T: DensityField + ?Sized> DensityField for &T {
+    type Segments<'a>
+        = T::Segments<'a>
+    where
+        Self: 'a;
+
+    fn bounds(&self) -> (Vec3, Vec3) {
+        (**self).bounds()
+    }
+    fn density(&self, p: Vec3) -> f32 {
+        (**self).density(p)
+    }
+    fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
+        (**self).segments(origin, dir, t_min, t_max)
+    }
+    fn global_majorant(&self) -> f32 {
+        (**self).global_majorant()
+    }
+    fn voxel_size(&self) -> f32 {
+        (**self).voxel_size()
+    }
+}

@@ -1,0 +1,239 @@
+//! The render loop: tiles over rayon, sample passes, time budget, progress.
+
+use std::io::IsTerminal;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+
+use crate::camera::Camera;
+use crate::film::{Film, Image};
+use crate::integrator::{
+    CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
+};
+use crate::medium::{DensityField, Medium};
+use crate::sampling::Rng;
+use crate::scene::{Budget, MajorantMode, RenderSettings, Scene};
+use crate::stats::{Counters, RenderStats};
+
+/// A finished render.
+pub struct Rendered {
+    pub image: Image,
+    pub stats: RenderStats,
+}
+
+/// Renders `scene` with `settings` on the ambient rayon pool (install a
+/// `ThreadPool` around the call to choose the thread count).
+///
+/// Pixel `(x, y)`'s sample `s` draws all its random numbers from
+/// `Rng::new(seed, y * width + x, s)`, and each pixel accumulates its
+/// samples in order, so the image is bit-identical for any thread count.
+pub fn render<F: DensityField>(scene: &Scene<F>, settings: &RenderSettings) -> Rendered {
+    let start = Instant::now();
+    match settings.majorant {
+        MajorantMode::Hierarchy => render_medium(scene, &scene.medium.by_ref(), settings, start),
+        MajorantMode::Global => {
+            render_medium(scene, &scene.medium.with_global_majorant(), settings, start)
+        }
+    }
+}
+
+fn render_medium<F: DensityField, G: DensityField>(
+    scene: &Scene<F>,
+    medium: &Medium<G>,
+    settings: &RenderSettings,
+    start: Instant,
+) -> Rendered {
+    let mut counters = Counters::default();
+    let lights = scene.lights;
+    let (image, setup_seconds) = match settings.integrator {
+        IntegratorKind::Path => {
+            let s = PathTracer::new(medium, lights, settings.transmittance, settings.max_depth);
+            (run(&s, &scene.camera, settings, start, &mut counters), 0.0)
+        }
+        IntegratorKind::RayMarch => {
+            let s = RayMarcher::new(medium, lights, settings.step_voxels);
+            (run(&s, &scene.camera, settings, start, &mut counters), 0.0)
+        }
+        IntegratorKind::RayMarch2Pass => {
+            let grid = LightGrid::build(
+                medium,
+                &lights,
+                settings.step_voxels,
+                &settings.light_grid,
+                settings.seed,
+                &mut counters,
+            );
+            let setup = start.elapsed().as_secs_f64();
+            let s = TwoPassMarcher::new(medium, lights, &grid, settings.step_voxels);
+            (
+                run(&s, &scene.camera, settings, start, &mut counters),
+                setup,
+            )
+        }
+    };
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let mut stats = RenderStats {
+        integrator: settings.integrator.name().into(),
+        transmittance: settings.transmittance.name().into(),
+        majorant: settings.majorant.name().into(),
+        width: image.width,
+        height: image.height,
+        spp: image.spp,
+        wall_seconds,
+        setup_seconds,
+        ..Default::default()
+    };
+    stats.fill_counters(&counters);
+    stats.rays_per_second = counters.paths as f64 / wall_seconds.max(1e-9);
+    Rendered { image, stats }
+}
+
+/// Runs sample passes until the budget is spent and resolves the film.
+fn run<S: CameraSampler>(
+    sampler: &S,
+    camera: &Camera,
+    settings: &RenderSettings,
+    start: Instant,
+    counters: &mut Counters,
+) -> Image {
+    let mut film = Film::new(camera.width(), camera.height(), settings.tile_size);
+    let progress = Progress::new(settings, camera);
+    let mut spp = 0u32;
+    match settings.budget {
+        Budget::Spp(n) => {
+            *counters += pass(
+                &mut film,
+                sampler,
+                camera,
+                settings.seed,
+                0,
+                n.max(1),
+                &progress,
+            );
+            spp = n.max(1);
+        }
+        Budget::Time(seconds) => {
+            let budget = Duration::from_secs_f64(seconds.max(0.0));
+            let loop_start = Instant::now();
+            let mut size = 1u32;
+            while size > 0 {
+                *counters += pass(
+                    &mut film,
+                    sampler,
+                    camera,
+                    settings.seed,
+                    spp,
+                    spp + size,
+                    &progress,
+                );
+                spp += size;
+                progress.set_spp(spp);
+                // Next pass: as many samples as the measured rate says fit in
+                // the remaining time, at most twice the last pass so one
+                // noisy estimate cannot overshoot the budget badly.
+                let per_spp = loop_start.elapsed().as_secs_f64() / spp as f64;
+                let remaining = budget.saturating_sub(start.elapsed()).as_secs_f64();
+                let fit = (remaining / per_spp.max(1e-9)).floor().min(u32::MAX as f64) as u32;
+                size = fit.min(size.saturating_mul(2));
+            }
+        }
+    }
+    progress.finish();
+    film.resolve(spp, counters)
+}
+
+/// One pass: samples `s0..s1` for every pixel, tiles in parallel.
+fn pass<S: CameraSampler>(
+    film: &mut Film,
+    sampler: &S,
+    camera: &Camera,
+    seed: u64,
+    s0: u32,
+    s1: u32,
+    progress: &Progress,
+) -> Counters {
+    let width = film.width;
+    film.tiles
+        .par_iter_mut()
+        .map(|tile| {
+            let mut c = Counters::default();
+            for ty in 0..tile.h {
+                for tx in 0..tile.w {
+                    let (x, y) = (tile.x0 + tx, tile.y0 + ty);
+                    let pixel = u64::from(y) * u64::from(width) + u64::from(x);
+                    for s in s0..s1 {
+                        let mut rng = Rng::new(seed, pixel, u64::from(s));
+                        let (u, v) = (rng.uniform(), rng.uniform());
+                        let ray = camera.ray(x as f32 + u, y as f32 + v);
+                        let sample = sampler.sample(ray, &mut rng, &mut c);
+                        tile.add(tx, ty, sample, &mut c);
+                    }
+                }
+            }
+            progress.tile_done(u64::from(tile.w * tile.h) * u64::from(s1 - s0));
+            c
+        })
+        .reduce(Counters::default, |a, b| a + b)
+}
+
+/// A progress bar with ETA on stderr, or nothing when stderr is not a
+/// terminal or progress is off. Updated once per tile, never per sample.
+struct Progress {
+    bar: Option<ProgressBar>,
+    /// With a time budget the bar measures milliseconds, not samples.
+    timed: Option<(Instant, u64)>,
+}
+
+impl Progress {
+    fn new(settings: &RenderSettings, camera: &Camera) -> Self {
+        let off = Self {
+            bar: None,
+            timed: None,
+        };
+        if !settings.progress || !std::io::stderr().is_terminal() {
+            return off;
+        }
+        let (len, timed) = match settings.budget {
+            Budget::Spp(n) => {
+                let samples =
+                    u64::from(camera.width()) * u64::from(camera.height()) * u64::from(n.max(1));
+                (samples, None)
+            }
+            Budget::Time(s) => {
+                let ms = (s * 1000.0).max(1.0) as u64;
+                (ms, Some((Instant::now(), ms)))
+            }
+        };
+        let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+        let style = ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] [{wide_bar}] {percent:>3}% ETA {eta} {msg}",
+        )
+        .expect("valid template");
+        bar.set_style(style);
+        Self {
+            bar: Some(bar),
+            timed,
+        }
+    }
+
+    fn tile_done(&self, samples: u64) {
+        let Some(bar) = &self.bar else { return };
+        match self.timed {
+            None => bar.inc(samples),
+            Some((t0, ms)) => bar.set_position((t0.elapsed().as_millis() as u64).min(ms)),
+        }
+    }
+
+    fn set_spp(&self, spp: u32) {
+        if let Some(bar) = &self.bar {
+            bar.set_message(format!("{spp} spp"));
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! What the caller fills in: the scene (medium, camera, lights) and the
+//! render settings.
+
+use serde::Serialize;
+
+use crate::camera::Camera;
+use crate::integrator::{IntegratorKind, LightGridSettings};
+use crate::light::Lights;
+use crate::medium::Medium;
+use crate::tracking::TransmittanceEstimator;
+
+/// A volume, a camera and lights at infinity, all in render space.
+pub struct Scene<F> {
+    pub medium: Medium<F>,
+    pub camera: Camera,
+    pub lights: Lights,
+}
+
+/// Which majorants the trackers use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MajorantMode {
+    /// The field's own local segments (its hierarchy or grid).
+    #[default]
+    Hierarchy,
+    /// One global majorant over the field's bounds (Mitsuba 3 style).
+    Global,
+}
+
+impl MajorantMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Hierarchy => "hierarchy",
+            Self::Global => "global",
+        }
+    }
+}
+
+/// How long to render.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Budget {
+    /// Exactly this many samples per pixel.
+    Spp(u32),
+    /// Progressive passes until this many seconds of wall time (setup
+    /// included) are spent; at least one sample per pixel is always taken
+    /// and every pixel has the same count. The count reached is reported.
+    Time(f64),
+}
+
+/// Everything about how to render, independent of the scene.
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    pub integrator: IntegratorKind,
+    pub transmittance: TransmittanceEstimator,
+    pub majorant: MajorantMode,
+    pub budget: Budget,
+    /// Same seed, same image, whatever the thread count.
+    pub seed: u64,
+    /// Scattering events per path (path tracer): 0 = environment through
+    /// the volume only, 1 = single scattering, `None` = unlimited.
+    pub max_depth: Option<u32>,
+    /// Ray-march step in voxels (ray marchers and the light grid).
+    pub step_voxels: f32,
+    pub light_grid: LightGridSettings,
+    /// Tile edge in pixels.
+    pub tile_size: u32,
+    /// Show a progress bar (only ever drawn when stderr is a terminal).
+    pub progress: bool,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            integrator: IntegratorKind::Path,
+            transmittance: TransmittanceEstimator::Ratio,
+            majorant: MajorantMode::Hierarchy,
+            budget: Budget::Spp(16),
+            seed: 0,
+            max_depth: None,
+            step_voxels: 0.5,
+            light_grid: LightGridSettings::default(),
+            tile_size: 16,
+            progress: true,
+        }
+    }
+}
+
+impl RenderSettings {
+    /// Checks values the renderer would otherwise have to clamp silently.
+    pub fn validate(&self) -> Result<(), String> {
+        match self.budget {
+            Budget::Spp(0) => return Err("spp must be at least 1".into()),
+            Budget::Time(s) if !(s.is_finite() && s > 0.0) => {
+                return Err(format!(
+                    "time budget must be a positive number of seconds, got {s}"
+                ))
+            }
+            _ => {}
+        }
+        if !(self.step_voxels.is_finite() && self.step_voxels > 0.0) {
+            return Err(format!(
+                "step must be a positive number of voxels, got {}",
+                self.step_voxels
+            ));
+        }
+        let g = &self.light_grid;
+        if !(g.cell_voxels.is_finite() && g.cell_voxels > 0.0) || g.env_directions == 0 {
+            return Err("light grid needs a positive cell size and at least one direction".into());
+        }
+        if self.tile_size == 0 {
+            return Err("tile size must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+impl<F> Scene<F> {
+    /// Checks the medium's parameters.
+    pub fn validate(&self) -> Result<(), String> {
+        let m = &self.medium;
+        if !(m.density_scale.is_finite() && m.density_scale >= 0.0) {
+            return Err(format!(
+                "density scale must be finite and >= 0, got {}",
+                m.density_scale
+            ));
+        }
+        if !m.albedo.is_finite() || m.albedo.min_element() < 0.0 || m.albedo.max_element() > 1.0 {
+            return Err(format!("albedo must lie in [0, 1], got {}", m.albedo));
+        }
+        Ok(())
+    }
+}

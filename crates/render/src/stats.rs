@@ -1,0 +1,98 @@
+//! Work counters and the statistics of a finished render.
+//!
+//! Counters are plain integers in a struct each rayon task owns; tasks sum
+//! theirs at the end of a pass, so the hot loops never touch an atomic.
+
+use std::ops::AddAssign;
+
+use serde::Serialize;
+
+/// What the integrators and trackers did; summed over tasks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Counters {
+    /// Camera samples (one path, or one marched camera ray, each).
+    pub paths: u64,
+    pub density_lookups: u64,
+    /// Delta-tracking collisions accepted as real.
+    pub real_collisions: u64,
+    /// Tentative collisions rejected as null, including every collision of
+    /// ratio and residual tracking.
+    pub null_collisions: u64,
+    /// Majorant segments visited by the trackers and ray marchers.
+    pub dda_segments: u64,
+    pub shadow_rays: u64,
+    /// Tracker calls stopped by the per-call collision cap.
+    pub collision_cap_hits: u64,
+    /// Density lookups that exceeded their segment's majorant (a field bug
+    /// that would bias delta tracking; ratio weights are clamped to 0).
+    pub majorant_violations: u64,
+    /// Samples that came out NaN or infinite and were replaced by 0.
+    pub nonfinite_samples: u64,
+}
+
+impl AddAssign for Counters {
+    fn add_assign(&mut self, o: Self) {
+        self.paths += o.paths;
+        self.density_lookups += o.density_lookups;
+        self.real_collisions += o.real_collisions;
+        self.null_collisions += o.null_collisions;
+        self.dda_segments += o.dda_segments;
+        self.shadow_rays += o.shadow_rays;
+        self.collision_cap_hits += o.collision_cap_hits;
+        self.majorant_violations += o.majorant_violations;
+        self.nonfinite_samples += o.nonfinite_samples;
+    }
+}
+
+impl std::ops::Add for Counters {
+    type Output = Self;
+    fn add(mut self, o: Self) -> Self {
+        self += o;
+        self
+    }
+}
+
+/// The statistics of a render, serialisable to JSON for benchmarks.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RenderStats {
+    pub integrator: String,
+    pub transmittance: String,
+    pub majorant: String,
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel actually taken (with a time budget: reached).
+    pub spp: u32,
+    pub wall_seconds: f64,
+    /// Part of `wall_seconds` spent before the first camera ray (the
+    /// two-pass light grid).
+    pub setup_seconds: f64,
+    pub paths: u64,
+    pub density_lookups: u64,
+    pub real_collisions: u64,
+    pub null_collisions: u64,
+    pub dda_segments: u64,
+    pub shadow_rays: u64,
+    pub collision_cap_hits: u64,
+    pub majorant_violations: u64,
+    pub nonfinite_samples: u64,
+    /// Camera paths per second of wall time.
+    pub rays_per_second: f64,
+}
+
+impl RenderStats {
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("stats serialise")
+    }
+
+    pub(crate) fn fill_counters(&mut self, c: &Counters) {
+        self.paths = c.paths;
+        self.density_lookups = c.density_lookups;
+        self.real_collisions = c.real_collisions;
+        self.null_collisions = c.null_collisions;
+        self.dda_segments = c.dda_segments;
+        self.shadow_rays = c.shadow_rays;
+        self.collision_cap_hits = c.collision_cap_hits;
+        self.majorant_violations = c.majorant_violations;
+        self.nonfinite_samples = c.nonfinite_samples;
+    }
+}

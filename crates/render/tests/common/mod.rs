@@ -1,0 +1,141 @@
+//! Shared scenes and statistics for the integration tests.
+#![allow(dead_code)]
+
+use cirrus_render::{
+    Budget, Camera, Environment, GridField, Image, IntegratorKind, Lights, Medium, RenderSettings,
+    Scene, Sun,
+};
+use glam::Vec3;
+
+/// A 16^3 cloud-like blob over roughly [0, 1]^3: a smooth falloff times a
+/// lumpy modulation, zero near the array's faces, so the field has empty
+/// cells, interior cells and structure for the majorant grid to bound.
+pub fn cloud_field(cell_voxels: usize) -> GridField {
+    let n = 16;
+    let vs = 1.0 / n as f32;
+    GridField::from_fn(
+        [n, n, n],
+        Vec3::splat(0.5 * vs),
+        vs,
+        cell_voxels,
+        |i, j, k| {
+            let p = (Vec3::new(i as f32, j as f32, k as f32) + 0.5) / n as f32 - 0.5;
+            let r2 = (p * Vec3::new(1.0, 1.4, 1.0)).length_squared() / 0.2;
+            let lumps =
+                0.65 + 0.35 * (9.0 * p.x).sin() * (7.0 * p.y + 1.0).cos() * (8.0 * p.z).sin();
+            ((1.0 - r2).max(0.0) * lumps).max(0.0)
+        },
+    )
+}
+
+pub fn medium<F: cirrus_render::DensityField>(
+    field: F,
+    scale: f32,
+    albedo: f32,
+    g: f32,
+) -> Medium<F> {
+    Medium::new(field, scale, Vec3::splat(albedo), g)
+}
+
+pub fn env(radiance: Vec3) -> Option<Environment> {
+    Some(Environment::new(radiance))
+}
+
+pub fn sun(angular_diameter_degrees: f32) -> Option<Sun> {
+    Some(Sun::new(
+        Vec3::new(-0.4, -1.0, -0.3),
+        Vec3::new(3.0, 2.8, 2.5),
+        angular_diameter_degrees.to_radians(),
+    ))
+}
+
+pub fn scene<F>(medium: Medium<F>, size: u32, lights: Lights) -> Scene<F>
+where
+    F: cirrus_render::DensityField,
+{
+    // Frame the blob's core rather than the array's bounds, so the blob
+    // fills the image.
+    let (lo, hi) = medium.field.bounds();
+    let centre = 0.5 * (lo + hi);
+    let blob = Vec3::new(0.3, 0.22, 0.3);
+    let camera = Camera::framing((centre - blob, centre + blob), size, size);
+    Scene {
+        medium,
+        camera,
+        lights,
+    }
+}
+
+pub fn settings(integrator: IntegratorKind, spp: u32, seed: u64) -> RenderSettings {
+    RenderSettings {
+        integrator,
+        budget: Budget::Spp(spp),
+        seed,
+        progress: false,
+        ..Default::default()
+    }
+}
+
+/// Per-pixel differences of two images in one channel and their variances
+/// `se_a^2 + se_b^2`, for pixels where that is positive; also the largest
+/// absolute difference where it is 0 (both exact, which must then agree up
+/// to rounding). One channel, because the channels of a pixel share their
+/// samples and are strongly correlated, which would break the independence
+/// the pooled tests assume.
+pub struct Differences {
+    pub diff: Vec<f64>,
+    pub var: Vec<f64>,
+    pub exact_diff: f64,
+}
+
+pub fn differences(a: &Image, b: &Image, channel: usize) -> Differences {
+    let mut d = Differences {
+        diff: Vec::new(),
+        var: Vec::new(),
+        exact_diff: 0.0,
+    };
+    for y in 0..a.height {
+        for x in 0..a.width {
+            let sa = a.std_error(x, y)[channel] as f64;
+            let sb = b.std_error(x, y)[channel] as f64;
+            let diff = a.pixel(x, y)[channel] as f64 - b.pixel(x, y)[channel] as f64;
+            if sa > 0.0 || sb > 0.0 {
+                d.diff.push(diff);
+                d.var.push(sa * sa + sb * sb);
+            } else {
+                d.exact_diff = d.exact_diff.max(diff.abs());
+            }
+        }
+    }
+    d
+}
+
+/// Pooled tests that two images estimate the same thing, for independent
+/// pixels:
+/// - bias: `sum(diff) / sqrt(sum(var))` is N(0, 1), so `|.| <= 4` fails
+///   falsely with probability 6.3e-5. (Summing per-pixel z-scores instead
+///   is itself biased: for a skewed estimator a pixel's mean and its
+///   estimated variance are correlated.)
+/// - spread: `sum(diff^2 / var)` is near chi-square with N degrees of
+///   freedom (mean N, standard deviation sqrt(2N)); `<= N + 5 sqrt(2N)`
+///   catches per-pixel disagreements that cancel in the sum. The slack
+///   beyond 4 standard deviations (Wilson-Hilferty: ~3e-5 for N in the
+///   hundreds) absorbs the t-like inflation of z with estimated standard
+///   errors (variance (n-1)/(n-3), 3% at 64 spp).
+///
+/// Also asserts exactly-known pixels agree to f32 rounding.
+pub fn assert_pooled_agreement(label: &str, d: &Differences) {
+    let n = d.diff.len() as f64;
+    assert!(n >= 50.0, "{label}: only {n} pixels with variance");
+    let bias = d.diff.iter().sum::<f64>() / d.var.iter().sum::<f64>().sqrt();
+    let chi2: f64 = d.diff.iter().zip(&d.var).map(|(x, v)| x * x / v).sum();
+    let chi2_bound = n + 5.0 * (2.0 * n).sqrt();
+    eprintln!("{label}: N = {n}, bias z = {bias:.3}, chi2 = {chi2:.1} (bound {chi2_bound:.1})");
+    assert!(bias.abs() <= 4.0, "{label}: pooled bias z = {bias}");
+    assert!(chi2 <= chi2_bound, "{label}: chi2 = {chi2} > {chi2_bound}");
+    assert!(
+        d.exact_diff <= 1e-5,
+        "{label}: exact pixels differ by {}",
+        d.exact_diff
+    );
+}
