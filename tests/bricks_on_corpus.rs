@@ -1,13 +1,18 @@
 //! The brick hierarchy on the corpus cloud: what issue 3 promises, measured.
 
 use cirrus::bricks::measure::{density_integral, measure, random_rays};
-use cirrus::bricks::{convert, read_cbrk, write_cbrk, FixedMajorantGrid, GlobalMajorant, Precision};
+use cirrus::bricks::{
+    convert, read_cbrk, write_cbrk, FixedMajorantGrid, GlobalMajorant, Precision,
+};
 use cirrus::vdb::VolumeFile;
 use std::path::Path;
 
 fn cloud() -> cirrus::vdb::Grid {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/cloud.vdb");
-    VolumeFile::open(path).unwrap().read_grid_by_name("density").unwrap()
+    VolumeFile::open(path)
+        .unwrap()
+        .read_grid_by_name("density")
+        .unwrap()
 }
 
 #[test]
@@ -20,13 +25,36 @@ fn hierarchy_is_4x_tighter_than_one_majorant_and_tighter_than_a_64_cubed_grid() 
     assert!(hits > 500, "only {hits} of the rays meet the cloud");
     let global = GlobalMajorant::new(&v);
     let fixed = FixedMajorantGrid::build(&v, 64);
-    let a = measure("global", &rays, &integrals, |r| global.segments(r.origin, r.dir, 0.0, r.t_max));
-    let b = measure("fixed 64^3", &rays, &integrals, |r| fixed.segments(r.origin, r.dir, 0.0, r.t_max));
-    let c = measure("hierarchy", &rays, &integrals, |r| v.segments(r.origin, r.dir, 0.0, r.t_max));
-    eprintln!("tightness: global {:.2}, fixed {:.2}, hierarchy {:.2}", a.tightness, b.tightness, c.tightness);
-    assert!(c.tightness >= 1.0 - 1e-3, "a bound below the density: {}", c.tightness);
-    assert!(a.tightness >= 4.0 * c.tightness, "global {} vs hierarchy {}", a.tightness, c.tightness);
-    assert!(c.tightness < b.tightness, "fixed grid {} vs hierarchy {}", b.tightness, c.tightness);
+    let a = measure("global", &rays, &integrals, |r| {
+        global.segments(r.origin, r.dir, 0.0, r.t_max)
+    });
+    let b = measure("fixed 64^3", &rays, &integrals, |r| {
+        fixed.segments(r.origin, r.dir, 0.0, r.t_max)
+    });
+    let c = measure("hierarchy", &rays, &integrals, |r| {
+        v.segments(r.origin, r.dir, 0.0, r.t_max)
+    });
+    eprintln!(
+        "tightness: global {:.2}, fixed {:.2}, hierarchy {:.2}",
+        a.tightness, b.tightness, c.tightness
+    );
+    assert!(
+        c.tightness >= 1.0 - 1e-3,
+        "a bound below the density: {}",
+        c.tightness
+    );
+    assert!(
+        a.tightness >= 4.0 * c.tightness,
+        "global {} vs hierarchy {}",
+        a.tightness,
+        c.tightness
+    );
+    assert!(
+        c.tightness < b.tightness,
+        "fixed grid {} vs hierarchy {}",
+        b.tightness,
+        c.tightness
+    );
 }
 
 #[test]
@@ -34,7 +62,11 @@ fn u8_bricks_take_at_most_a_third_of_the_readers_tree() {
     let grid = cloud();
     let tree_bytes = grid.tree.memory_bytes();
     let v = convert(&grid, Precision::U8).unwrap();
-    assert!(3 * v.total_bytes() <= tree_bytes, "u8 bricks {} bytes, tree {tree_bytes}", v.total_bytes());
+    assert!(
+        3 * v.total_bytes() <= tree_bytes,
+        "u8 bricks {} bytes, tree {tree_bytes}",
+        v.total_bytes()
+    );
     assert_eq!(v.info.active_voxels, grid.tree.active_voxel_count());
 }
 
