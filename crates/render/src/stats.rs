@@ -15,9 +15,11 @@ pub struct Counters {
     pub density_lookups: u64,
     /// Delta-tracking collisions accepted as real.
     pub real_collisions: u64,
-    /// Tentative collisions rejected as null, including every collision of
-    /// ratio and residual tracking.
+    /// Delta-tracking collisions rejected as null.
     pub null_collisions: u64,
+    /// Tentative collisions of ratio and residual tracking (shadow rays),
+    /// each a density lookup and a weight.
+    pub shadow_collisions: u64,
     /// Majorant segments visited by the trackers and ray marchers.
     pub dda_segments: u64,
     pub shadow_rays: u64,
@@ -36,6 +38,7 @@ impl AddAssign for Counters {
         self.density_lookups += o.density_lookups;
         self.real_collisions += o.real_collisions;
         self.null_collisions += o.null_collisions;
+        self.shadow_collisions += o.shadow_collisions;
         self.dda_segments += o.dda_segments;
         self.shadow_rays += o.shadow_rays;
         self.collision_cap_hits += o.collision_cap_hits;
@@ -70,6 +73,7 @@ pub struct RenderStats {
     pub density_lookups: u64,
     pub real_collisions: u64,
     pub null_collisions: u64,
+    pub shadow_collisions: u64,
     pub dda_segments: u64,
     pub shadow_rays: u64,
     pub collision_cap_hits: u64,
@@ -89,6 +93,7 @@ impl RenderStats {
         self.density_lookups = c.density_lookups;
         self.real_collisions = c.real_collisions;
         self.null_collisions = c.null_collisions;
+        self.shadow_collisions = c.shadow_collisions;
         self.dda_segments = c.dda_segments;
         self.shadow_rays = c.shadow_rays;
         self.collision_cap_hits = c.collision_cap_hits;

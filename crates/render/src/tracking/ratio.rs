@@ -30,7 +30,7 @@ pub fn ratio_tracking<F: DensityField>(
             Event::End => return tr,
             Event::Capped => return 0.0,
             Event::Collision { t, segment } => {
-                c.null_collisions += 1;
+                c.shadow_collisions += 1;
                 let sigma = lookup(medium, ray, t, segment.sigma_maj, c);
                 tr *= (1.0 - sigma / segment.sigma_maj).max(0.0);
                 if !roulette(&mut tr, rng) {

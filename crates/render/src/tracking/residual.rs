@@ -42,7 +42,7 @@ pub fn residual_ratio_tracking<F: DensityField>(
                 }
             }
             Event::Collision { t, segment } => {
-                c.null_collisions += 1;
+                c.shadow_collisions += 1;
                 let sigma = lookup(medium, ray, t, segment.sigma_maj, c);
                 tr *= (1.0 - (sigma - segment.sigma_min) / segment.rate).max(0.0);
                 if !roulette(&mut tr, rng) {
