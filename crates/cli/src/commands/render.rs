@@ -5,25 +5,36 @@ use super::CliResult;
 use cirrus_bricks::{convert, read_cbrk, BrickVolume, Precision};
 use cirrus_render::image_io::{write_exr, write_png};
 use cirrus_render::medium::BrickField;
+use cirrus_render::DensityField;
 use cirrus_render::{
     render, Budget, Camera, Environment, IntegratorKind, Lights, MajorantMode, Medium,
     RenderSettings, Scene, Sun, TransmittanceEstimator,
 };
 use cirrus_vdb::VolumeFile;
-use glam::{DMat4, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Parses "x,y,z" (a leading minus is fine).
-fn vec3(s: &str) -> Result<Vec3, String> {
-    let v: Vec<f32> = s
+/// Three finite numbers "x,y,z" (a leading minus is fine).
+fn triple(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
         .split(',')
-        .map(|c| c.trim().parse::<f32>().map_err(|e| format!("{s:?}: {e}")))
+        .map(|c| c.trim().parse::<f64>().map_err(|e| format!("{s:?}: {e}")))
         .collect::<Result<_, _>>()?;
     match v[..] {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([x, y, z]),
         _ => Err(format!("expected three finite numbers x,y,z, got {s:?}")),
     }
+}
+
+/// A world position, kept in f64 until it is moved into render space.
+fn point(s: &str) -> Result<DVec3, String> {
+    triple(s).map(DVec3::from_array)
+}
+
+/// A direction or colour.
+fn vec3(s: &str) -> Result<Vec3, String> {
+    triple(s).map(|v| DVec3::from_array(v).as_vec3())
 }
 
 fn resolution(s: &str) -> Result<(u32, u32), String> {
@@ -67,10 +78,10 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Camera position (world space); default: framed on the volume.
-    #[arg(long, value_parser = vec3, allow_hyphen_values = true, requires = "camera_to")]
-    pub camera_from: Option<Vec3>,
-    #[arg(long, value_parser = vec3, allow_hyphen_values = true, requires = "camera_from")]
-    pub camera_to: Option<Vec3>,
+    #[arg(long, value_parser = point, allow_hyphen_values = true, requires = "camera_to")]
+    pub camera_from: Option<DVec3>,
+    #[arg(long, value_parser = point, allow_hyphen_values = true, requires = "camera_from")]
+    pub camera_to: Option<DVec3>,
     #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,1,0")]
     pub camera_up: Vec3,
     /// Vertical field of view in degrees.
@@ -134,15 +145,18 @@ pub fn load_volume(
     Ok(convert(&g, Precision::F32).map_err(|e| format!("{}: {e}", file.display()))?)
 }
 
-pub fn run(args: &RenderArgs) -> CliResult {
-    let start = Instant::now();
-    let volume = load_volume(&args.file, args.grid.as_deref())?;
-    let load_seconds = start.elapsed().as_secs_f64();
-    // Render space: world minus the volume's centre, so f32 stays precise far from the origin.
+/// The scene and settings that `args` describe, over a loaded volume.
+///
+/// Render space is world space minus the volume's centre, computed in f64,
+/// so f32 stays precise for volumes far from the origin.
+pub fn prepare<'v>(
+    args: &RenderArgs,
+    volume: &'v BrickVolume,
+) -> Result<(Scene<BrickField<'v>>, RenderSettings), Box<dyn std::error::Error>> {
     let world_from_local = volume.local_from_world().inverse();
     let centre = world_from_local.transform_point3(volume.local_extent().as_dvec3() * 0.5);
-    let field = BrickField::new(&volume, DMat4::IDENTITY, centre);
-    let to_render = |p: Vec3| (p.as_dvec3() - centre).as_vec3();
+    let field = BrickField::new(volume, DMat4::IDENTITY, centre);
+    let to_render = |p: DVec3| (p - centre).as_vec3();
     let (w, h) = args.res;
     let camera = match (args.camera_from, args.camera_to) {
         (Some(from), Some(to)) => Camera::new(
@@ -153,11 +167,9 @@ pub fn run(args: &RenderArgs) -> CliResult {
             w,
             h,
         ),
-        _ => Camera::framing(cirrus_render::DensityField::bounds(&field), w, h),
+        _ => Camera::framing(field.bounds(), w, h),
     };
-    let density_scale = args
-        .density_scale
-        .unwrap_or(1.0 / cirrus_render::DensityField::voxel_size(&field));
+    let density_scale = args.density_scale.unwrap_or(0.5 / field.voxel_size());
     let lights = Lights {
         sun: (!args.no_sun).then(|| {
             Sun::new(
@@ -203,6 +215,15 @@ pub fn run(args: &RenderArgs) -> CliResult {
         ..Default::default()
     };
     settings.validate()?;
+    Ok((scene, settings))
+}
+
+pub fn run(args: &RenderArgs) -> CliResult {
+    let start = Instant::now();
+    let volume = load_volume(&args.file, args.grid.as_deref())?;
+    let load_seconds = start.elapsed().as_secs_f64();
+    let (w, h) = args.res;
+    let (scene, settings) = prepare(args, &volume)?;
     let rendered = render(&scene, &settings);
     write_exr(&args.output, &rendered.image)
         .map_err(|e| format!("{}: {e}", args.output.display()))?;
