@@ -53,11 +53,8 @@ fn resolution(s: &str) -> Result<(u32, u32), String> {
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// A .vdb, .nvdb or .cbrk file.
-    pub file: PathBuf,
-    /// The density grid (default: "density", else the first float grid).
-    #[arg(long)]
-    pub grid: Option<String>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
     /// Output EXR (RGBA f32; alpha = 1 - camera-ray transmittance).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -67,6 +64,20 @@ pub struct RenderArgs {
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
+    /// Write render statistics as JSON.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+}
+
+/// What to render and how: everything but the outputs, shared with the
+/// benchmarks that render the same scene many times.
+#[derive(clap::Args, Clone)]
+pub struct SceneArgs {
+    /// A .vdb, .nvdb or .cbrk file.
+    pub file: PathBuf,
+    /// The density grid (default: "density", else the first float grid).
+    #[arg(long)]
+    pub grid: Option<String>,
     #[arg(long, default_value = "512x512", value_parser = resolution)]
     pub res: (u32, u32),
     /// Samples per pixel.
@@ -126,9 +137,6 @@ pub struct RenderArgs {
     /// Ray-march step in voxels.
     #[arg(long, default_value_t = 0.5)]
     pub step: f32,
-    /// Write render statistics as JSON.
-    #[arg(long)]
-    pub stats: Option<PathBuf>,
 }
 
 /// Loads the volume of a .vdb/.nvdb (converted at f32) or a .cbrk.
@@ -150,7 +158,7 @@ pub fn load_volume(
 /// Render space is world space minus the volume's centre, computed in f64,
 /// so f32 stays precise for volumes far from the origin.
 pub fn prepare<'v>(
-    args: &RenderArgs,
+    args: &SceneArgs,
     volume: &'v BrickVolume,
 ) -> Result<(Scene<BrickField<'v>>, RenderSettings), Box<dyn std::error::Error>> {
     let world_from_local = volume.local_from_world().inverse();
@@ -220,10 +228,10 @@ pub fn prepare<'v>(
 
 pub fn run(args: &RenderArgs) -> CliResult {
     let start = Instant::now();
-    let volume = load_volume(&args.file, args.grid.as_deref())?;
+    let volume = load_volume(&args.scene.file, args.scene.grid.as_deref())?;
     let load_seconds = start.elapsed().as_secs_f64();
-    let (w, h) = args.res;
-    let (scene, settings) = prepare(args, &volume)?;
+    let (w, h) = args.scene.res;
+    let (scene, settings) = prepare(&args.scene, &volume)?;
     let rendered = render(&scene, &settings);
     write_exr(&args.output, &rendered.image)
         .map_err(|e| format!("{}: {e}", args.output.display()))?;

@@ -8,12 +8,15 @@
 //! the bricks' segments come back in the caller's `t`.
 
 use super::field::{DensityField, MajorantSegment};
-use cirrus_bricks::{BrickVolume, RaySegment, SegmentIter};
+use cirrus_bricks::{BrickVolume, FixedGridIter, FixedMajorantGrid, RaySegment, SegmentIter};
 use glam::{DMat4, DVec3, Mat4, Vec3};
 
 /// A [`BrickVolume`] placed in render space.
 pub struct BrickField<'v> {
     volume: &'v BrickVolume,
+    /// A pbrt-v4-style fixed majorant grid used instead of the hierarchy,
+    /// for the benchmarks that compare the two.
+    fixed: Option<FixedMajorantGrid>,
     local_from_render: Mat4,
     bounds: (Vec3, Vec3),
     voxel_size: f32,
@@ -47,6 +50,7 @@ impl<'v> BrickField<'v> {
             .fold(f64::INFINITY, f64::min) as f32;
         BrickField {
             volume,
+            fixed: None,
             local_from_render: local_from_render.as_mat4(),
             bounds: (lo, hi),
             voxel_size,
@@ -57,20 +61,41 @@ impl<'v> BrickField<'v> {
     pub fn volume(&self) -> &BrickVolume {
         self.volume
     }
+
+    /// Walks a fixed `res^3` majorant grid over the volume (pbrt-v4's
+    /// `MajorantGrid`, 64^3 in its NanoVDB medium) instead of the hierarchy.
+    pub fn with_fixed_grid(mut self, res: i32) -> Self {
+        self.fixed = Some(FixedMajorantGrid::build(self.volume, res));
+        self
+    }
 }
 
-fn to_segment(s: RaySegment) -> MajorantSegment {
-    MajorantSegment {
-        t0: s.t0,
-        t1: s.t1,
-        minorant: s.minorant,
-        majorant: s.majorant,
+/// Segments of either majorant structure.
+pub enum BrickSegments<'a> {
+    Hierarchy(SegmentIter<'a>),
+    Fixed(FixedGridIter<'a>),
+}
+
+impl Iterator for BrickSegments<'_> {
+    type Item = MajorantSegment;
+    #[inline]
+    fn next(&mut self) -> Option<MajorantSegment> {
+        let s: RaySegment = match self {
+            BrickSegments::Hierarchy(it) => it.next()?,
+            BrickSegments::Fixed(it) => it.next()?,
+        };
+        Some(MajorantSegment {
+            t0: s.t0,
+            t1: s.t1,
+            minorant: s.minorant,
+            majorant: s.majorant,
+        })
     }
 }
 
 impl DensityField for BrickField<'_> {
     type Segments<'a>
-        = std::iter::Map<SegmentIter<'a>, fn(RaySegment) -> MajorantSegment>
+        = BrickSegments<'a>
     where
         Self: 'a;
 
@@ -87,9 +112,10 @@ impl DensityField for BrickField<'_> {
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
         let o = self.local_from_render.transform_point3(origin);
         let d = self.local_from_render.transform_vector3(dir);
-        self.volume
-            .segments(o, d, t_min, t_max)
-            .map(to_segment as fn(RaySegment) -> MajorantSegment)
+        match &self.fixed {
+            None => BrickSegments::Hierarchy(self.volume.segments(o, d, t_min, t_max)),
+            Some(grid) => BrickSegments::Fixed(grid.segments(o, d, t_min, t_max)),
+        }
     }
 
     fn global_majorant(&self) -> f32 {

@@ -14,7 +14,7 @@ mod global;
 mod grid_field;
 mod majorant_grid;
 
-pub use brick_field::BrickField;
+pub use brick_field::{BrickField, BrickSegments};
 pub use constant_box::ConstantBox;
 pub use field::{DensityField, MajorantSegment};
 pub use global::GlobalMajorant;
