@@ -9,6 +9,12 @@
 //! - a cell whose minorant is at least half its majorant is one segment
 //!   (delta tracking there takes at most one null collision per real one
 //!   on average, so finer cells would buy little for more steps);
+//! - a cell whose bounds differ by less than `split` across its width (in
+//!   density x voxels) is one segment: the caller sets `split` to the
+//!   optical-depth slack it accepts, which is Blender Cycles' rule for its
+//!   majorant octree (a node splits while range x size x scale > 1.442):
+//!   crossing such a cell costs on average at most that many extra null
+//!   collisions, so refining it would cost more steps than it saves;
 //! - otherwise the walk descends, down to 4^3 cells, which are always one
 //!   segment each.
 //!
@@ -54,6 +60,8 @@ pub struct SegmentIter<'a> {
     level: usize,
     /// Absolute part of the nudge: 1e-5 voxels along the ray's major axis.
     nudge_abs: f32,
+    /// Cells whose (max - min) x width in voxels is at most this are not refined.
+    split: f32,
 }
 
 /// Slab test of a ray against the box [lo, hi]: the parameter interval inside.
@@ -89,6 +97,7 @@ impl<'a> SegmentIter<'a> {
             steps: 0,
             level: 0,
             nudge_abs: 1e-5 / dir.abs().max_element(),
+            split: 0.0,
         }
     }
 
@@ -113,7 +122,9 @@ impl<'a> SegmentIter<'a> {
             }
             let (lo, hi) = loop {
                 let (lo, hi) = bounds_at(l);
-                if hi <= 0.0 || lo >= hi * TIGHT_ENOUGH || l == 0 {
+                let width = (1u32 << (CELL_LOG2 + l as u32)) as f32;
+                if hi <= 0.0 || lo >= hi * TIGHT_ENOUGH || (hi - lo) * width <= self.split || l == 0
+                {
                     break (lo, hi);
                 }
                 l -= 1;
@@ -167,5 +178,21 @@ impl BrickVolume {
     /// coordinates) within `[t_min, t_max]`.
     pub fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> SegmentIter<'_> {
         SegmentIter::new(self, origin, dir, t_min, t_max)
+    }
+
+    /// Segments that stop refining where a cell's bounds differ by at most
+    /// `split` density x voxels across its width (see the module doc).
+    pub fn segments_with_split(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        t_max: f32,
+        split: f32,
+    ) -> SegmentIter<'_> {
+        SegmentIter {
+            split: split.max(0.0),
+            ..SegmentIter::new(self, origin, dir, t_min, t_max)
+        }
     }
 }

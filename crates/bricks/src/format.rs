@@ -256,11 +256,7 @@ pub fn read_cbrk(path: &Path) -> Result<BrickVolume, BrickError> {
                 format!("{what} holds {len} bytes, expected {count} values"),
             ));
         }
-        Ok(Section::Mapped {
-            map: map.clone(),
-            offset,
-            len,
-        })
+        Ok(Section::mapped(map.clone(), offset, len))
     }
     let bricks = dims
         .iter()
