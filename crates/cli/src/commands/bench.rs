@@ -13,6 +13,9 @@ pub enum BenchCommand {
     /// Segments per ray, rays/s, lookups/s and bound tightness for a global
     /// majorant, a fixed pbrt-style grid and cirrus's hierarchy.
     Traverse(TraverseArgs),
+    /// Run time against error for every estimator and majorant structure,
+    /// with a converged reference: results.csv, error_vs_time.png, report.md.
+    Error(Box<super::bench_error::ErrorArgs>),
 }
 
 #[derive(clap::Args)]
@@ -36,6 +39,7 @@ pub struct TraverseArgs {
 pub fn run(cmd: &BenchCommand) -> CliResult {
     match cmd {
         BenchCommand::Traverse(args) => traverse(args),
+        BenchCommand::Error(args) => super::bench_error::run(args),
     }
 }
 

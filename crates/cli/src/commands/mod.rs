@@ -1,4 +1,6 @@
 pub mod bench;
+pub mod bench_error;
+pub mod bench_plot;
 pub mod convert;
 pub mod info;
 pub mod render;
