@@ -18,6 +18,11 @@
 //! - otherwise the walk descends, down to 4^3 cells, which are always one
 //!   segment each.
 //!
+//! - at extreme optical thickness (the caller's `voxel_split`: a finest
+//!   cell whose bounds differ by that many density x voxels), the walk goes
+//!   down to single voxel cells bounded by their eight corners, so a steep
+//!   edge in a dense medium does not cost millions of null collisions.
+//!
 //! Neighbouring segments with the same bounds merge into one. The ray is
 //! given in local index coordinates of the volume (`BrickVolume::local_from_world`
 //! applied to a world ray): an affine map keeps the ray parameter, so `t`
@@ -62,6 +67,8 @@ pub struct SegmentIter<'a> {
     nudge_abs: f32,
     /// Cells whose (max - min) x width in voxels is at most this are not refined.
     split: f32,
+    /// Finest cells whose (max - min) x width exceeds this are walked voxel by voxel.
+    voxel_split: f32,
 }
 
 /// Slab test of a ray against the box [lo, hi]: the parameter interval inside.
@@ -98,6 +105,7 @@ impl<'a> SegmentIter<'a> {
             level: 0,
             nudge_abs: 1e-5 / dir.abs().max_element(),
             split: 0.0,
+            voxel_split: f32::INFINITY,
         }
     }
 
@@ -120,7 +128,7 @@ impl<'a> SegmentIter<'a> {
             while l < top && bounds_at(l + 1).1 <= 0.0 {
                 l += 1;
             }
-            let (lo, hi) = loop {
+            let (mut lo, mut hi) = loop {
                 let (lo, hi) = bounds_at(l);
                 let width = (1u32 << (CELL_LOG2 + l as u32)) as f32;
                 if hi <= 0.0 || lo >= hi * TIGHT_ENOUGH || (hi - lo) * width <= self.split || l == 0
@@ -131,8 +139,16 @@ impl<'a> SegmentIter<'a> {
             };
             self.level = l;
             // Exit through the cell's far faces (the near ones are behind us).
-            let size = (1i32 << (CELL_LOG2 + l as u32)) as f32;
-            let cell_lo = (voxel >> (CELL_LOG2 + l as u32) as i32).as_vec3() * size;
+            let mut size = (1i32 << (CELL_LOG2 + l as u32)) as f32;
+            let mut cell_lo = (voxel >> (CELL_LOG2 + l as u32) as i32).as_vec3() * size;
+            if l == 0 && hi > lo && (hi - lo) * size > self.voxel_split {
+                // A finest cell so optically thick that even its few voxels
+                // of slack cost many null collisions: bound the one voxel
+                // cell [v, v + 1) by its eight corner voxels instead.
+                (lo, hi) = self.volume.voxel_cell_range(voxel);
+                size = 1.0;
+                cell_lo = voxel.as_vec3();
+            }
             let far =
                 cell_lo + Vec3::select(self.dir.cmpge(Vec3::ZERO), Vec3::splat(size), Vec3::ZERO);
             let exit = ((far - self.origin) * self.inv_dir).min_element();
@@ -181,7 +197,9 @@ impl BrickVolume {
     }
 
     /// Segments that stop refining where a cell's bounds differ by at most
-    /// `split` density x voxels across its width (see the module doc).
+    /// `split` density x voxels across its width, and walk finest cells
+    /// whose bounds differ by more than `voxel_split` voxel by voxel (see
+    /// the module doc).
     pub fn segments_with_split(
         &self,
         origin: Vec3,
@@ -189,9 +207,11 @@ impl BrickVolume {
         t_min: f32,
         t_max: f32,
         split: f32,
+        voxel_split: f32,
     ) -> SegmentIter<'_> {
         SegmentIter {
             split: split.max(0.0),
+            voxel_split,
             ..SegmentIter::new(self, origin, dir, t_min, t_max)
         }
     }

@@ -174,6 +174,18 @@ impl BrickVolume {
         }
     }
 
+    /// (min, max) of the trilinear density over the voxel cell `[c, c + 1)`:
+    /// the range of its eight corner voxels.
+    pub fn voxel_cell_range(&self, c: IVec3) -> (f32, f32) {
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for k in 0..8 {
+            let v = self.voxel(c + IVec3::new(k >> 2, (k >> 1) & 1, k & 1));
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        (lo, hi)
+    }
+
     /// Nearest-voxel density at a local index point.
     #[inline]
     pub fn nearest(&self, p: Vec3) -> f32 {

@@ -94,14 +94,32 @@ fn check_ray(
     samples: &[f32],
 ) {
     let lo = local(vol, o);
-    let segs: Vec<RaySegment> = vol.segments(lo, d, t_min, t_max).collect();
+    // The plain walk, a coarse one (cells refined only when their bounds
+    // differ by over 2 density x voxels), and one that goes voxel by voxel.
+    for (split, voxel_split) in [(0.0, f32::INFINITY), (2.0, f32::INFINITY), (0.0, 0.0)] {
+        let segs: Vec<RaySegment> = vol
+            .segments_with_split(lo, d, t_min, t_max, split, voxel_split)
+            .collect();
+        check_segments(tree, o, d, t_min, t_max, samples, &segs);
+    }
+}
+
+fn check_segments(
+    tree: &Tree<f32>,
+    o: Vec3,
+    d: Vec3,
+    t_min: f32,
+    t_max: f32,
+    samples: &[f32],
+    segs: &[RaySegment],
+) {
     for w in segs.windows(2) {
         assert!(
             w[0].t1 <= w[1].t0,
             "segments overlap or are out of order: {w:?}"
         );
     }
-    for s in &segs {
+    for s in segs {
         assert!(
             s.t0 >= t_min && s.t1 <= t_max && s.t0 < s.t1,
             "segment {s:?} outside [{t_min}, {t_max}]"

@@ -25,20 +25,33 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Convert a float grid into sparse bricks (.cbrk).
     Convert(commands::convert::ConvertArgs),
-    /// Render a volume to EXR (and PNG).
+    /// Render a volume, or a scene file (.toml), to EXR (and PNG).
     Render(Box<commands::render::RenderArgs>),
+    /// Assemble crop tiles (`render --crop`) into one full-size EXR.
+    Merge(commands::merge::MergeArgs),
     /// Benchmarks that print figures.
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // The matches are kept so `render` can tell flags given on the command
+    // line (which override a scene file) from defaults.
+    let matches = <Cli as clap::CommandFactory>::command().get_matches();
+    let cli = match <Cli as clap::FromArgMatches>::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
+    let sub = matches
+        .subcommand()
+        .map(|(_, m)| m.clone())
+        .unwrap_or_default();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
         Command::Convert(args) => commands::convert::run(&args),
         Command::Bench(cmd) => commands::bench::run(&cmd),
-        Command::Render(args) => commands::render::run(&args),
+        Command::Render(args) => commands::render::run(&args, &sub),
+        Command::Merge(args) => commands::merge::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -16,6 +16,9 @@ pub enum BenchCommand {
     /// Run time against error for every estimator and majorant structure,
     /// with a converged reference: results.csv, error_vs_time.png, report.md.
     Error(Box<super::bench_error::ErrorArgs>),
+    /// Numerical stress: extreme scales, sizes, positions, grazing rays,
+    /// cameras inside volumes, bad voxels, underflowing optical depths.
+    Stress(super::bench_stress::StressArgs),
 }
 
 #[derive(clap::Args)]
@@ -40,6 +43,7 @@ pub fn run(cmd: &BenchCommand) -> CliResult {
     match cmd {
         BenchCommand::Traverse(args) => traverse(args),
         BenchCommand::Error(args) => super::bench_error::run(args),
+        BenchCommand::Stress(args) => super::bench_stress::run(args),
     }
 }
 

@@ -1,9 +1,14 @@
 pub mod bench;
 pub mod bench_error;
 pub mod bench_plot;
+pub mod bench_stress;
 pub mod convert;
 pub mod info;
+pub mod merge;
 pub mod render;
+pub mod scene_cull;
+pub mod scene_file;
+pub mod scene_render;
 
 /// The error every subcommand returns: printed once by `main`.
 pub type CliResult = Result<(), Box<dyn std::error::Error>>;

@@ -3,16 +3,19 @@
 
 use super::CliResult;
 use cirrus_bricks::{convert, read_cbrk, BrickVolume, Precision};
-use cirrus_render::image_io::{write_exr, write_png};
+use cirrus_render::exr_layers::{write_exr_layers, Aov};
+use cirrus_render::image_io::write_png;
 use cirrus_render::medium::BrickField;
 use cirrus_render::DensityField;
 use cirrus_render::{
-    render, Budget, Camera, Environment, IntegratorKind, Lights, MajorantMode, Medium,
-    RenderSettings, Scene, Sun, TransmittanceEstimator,
+    render, Budget, Camera, Crop, EnvMap, Environment, IntegratorKind, Lights, MajorantMode,
+    Medium, RenderSettings, Rendered, Scene, Sun, TransmittanceEstimator,
 };
 use cirrus_vdb::VolumeFile;
+use clap::ArgMatches;
 use glam::{DMat4, DVec3, Vec3};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Three finite numbers "x,y,z" (a leading minus is fine).
@@ -37,7 +40,7 @@ fn vec3(s: &str) -> Result<Vec3, String> {
     triple(s).map(|v| DVec3::from_array(v).as_vec3())
 }
 
-fn resolution(s: &str) -> Result<(u32, u32), String> {
+pub fn resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WxH, got {s:?}"))?;
@@ -55,9 +58,10 @@ fn resolution(s: &str) -> Result<(u32, u32), String> {
 pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Output EXR (RGBA f32; alpha = 1 - camera-ray transmittance).
+    /// Output EXR (RGBA f32; alpha = 1 - camera-ray transmittance); a
+    /// scene file may give it instead (`[output] exr`).
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
     /// Also write an sRGB PNG preview.
     #[arg(long)]
     pub png: Option<PathBuf>,
@@ -67,6 +71,25 @@ pub struct RenderArgs {
     /// Write render statistics as JSON.
     #[arg(long)]
     pub stats: Option<PathBuf>,
+    /// AOV layers to add to the EXR: albedo, depth, emission, direct, samples.
+    #[arg(long, value_delimiter = ',', value_parser = Aov::parse)]
+    pub aov: Vec<Aov>,
+    /// Render only the pixels [x0, x1) x [y0, y1) into a full-size EXR with
+    /// a data window (merge tiles with `cirrus merge`).
+    #[arg(long, value_parser = crop)]
+    pub crop: Option<Crop>,
+}
+
+/// "x0,y0,x1,y1" in pixels.
+pub fn crop(s: &str) -> Result<Crop, String> {
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|c| c.trim().parse::<u32>().map_err(|e| format!("{s:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x0, y0, x1, y1] => Ok(Crop { x0, y0, x1, y1 }),
+        _ => Err(format!("expected x0,y0,x1,y1, got {s:?}")),
+    }
 }
 
 /// What to render and how: everything but the outputs, shared with the
@@ -112,6 +135,15 @@ pub struct SceneArgs {
     /// Constant sky radiance (0,0,0 for none).
     #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0.16,0.22,0.34")]
     pub env_radiance: Vec3,
+    /// A lat-long HDR sky (EXR) instead of the constant radiance.
+    #[arg(long)]
+    pub env_map: Option<PathBuf>,
+    /// Rotation of the sky map about +Y, in degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub env_rotation: f32,
+    /// Multiplier of the sky map's radiance.
+    #[arg(long, default_value_t = 1.0)]
+    pub env_intensity: f32,
     /// Extinction per unit density, in 1/world units (default: 0.5 / voxel
     /// size, so density 1 is half a mean free path per voxel).
     #[arg(long)]
@@ -149,13 +181,37 @@ pub fn load_volume(
     file: &PathBuf,
     grid: Option<&str>,
 ) -> Result<BrickVolume, Box<dyn std::error::Error>> {
+    Ok(load_volume_counted(file, grid)?.0)
+}
+
+/// [`load_volume`] and the bytes it read from disk (a .cbrk counts whole).
+pub fn load_volume_counted(
+    file: &PathBuf,
+    grid: Option<&str>,
+) -> Result<(BrickVolume, u64), Box<dyn std::error::Error>> {
     if file.extension().is_some_and(|e| e == "cbrk") {
-        return Ok(read_cbrk(file)?);
+        let bytes = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
+        return Ok((read_cbrk(file)?, bytes));
     }
     let f = VolumeFile::open(file)?;
     let index = super::convert::choose_grid(&f, grid)?;
     let g = f.read_grid(index)?;
-    Ok(convert(&g, Precision::F32).map_err(|e| format!("{}: {e}", file.display()))?)
+    let volume = convert(&g, Precision::F32).map_err(|e| format!("{}: {e}", file.display()))?;
+    Ok((volume, f.bytes_read()))
+}
+
+/// The sky: the map if one is given, else the constant radiance.
+pub fn environment(args: &SceneArgs) -> Result<Environment, String> {
+    match &args.env_map {
+        None => Ok(Environment::new(args.env_radiance)),
+        Some(path) => {
+            let map = EnvMap::read_exr(path, args.env_rotation)?;
+            Ok(Environment::from_map(
+                Arc::new(map),
+                Vec3::splat(args.env_intensity),
+            ))
+        }
+    }
 }
 
 /// The scene and settings that `args` describe, over a loaded volume.
@@ -184,7 +240,20 @@ pub fn prepare<'v>(
     };
     let density_scale = args.density_scale.unwrap_or(0.5 / field.voxel_size());
     let field = field.with_refinement(density_scale, args.refine_optical_depth);
-    let lights = Lights {
+    let lights = lights(args)?;
+    let scene = Scene {
+        medium: Medium::new(field, density_scale, Vec3::splat(args.albedo), args.g),
+        camera,
+        lights,
+    };
+    scene.validate()?;
+    let settings = settings(args)?;
+    Ok((scene, settings))
+}
+
+/// The sun and sky that `args` describe (absent or black lights pruned).
+pub fn lights(args: &SceneArgs) -> Result<Lights, String> {
+    Ok(Lights {
         sun: (!args.no_sun).then(|| {
             Sun::new(
                 args.sun_dir,
@@ -192,15 +261,13 @@ pub fn prepare<'v>(
                 args.sun_angle.to_radians(),
             )
         }),
-        environment: Some(Environment::new(args.env_radiance)),
+        environment: Some(environment(args)?),
     }
-    .pruned();
-    let scene = Scene {
-        medium: Medium::new(field, density_scale, Vec3::splat(args.albedo), args.g),
-        camera,
-        lights,
-    };
-    scene.validate()?;
+    .pruned())
+}
+
+/// The render settings that `args` describe, validated.
+pub fn settings(args: &SceneArgs) -> Result<RenderSettings, String> {
     let settings = RenderSettings {
         integrator: match args.integrator.as_str() {
             "raymarch" => IntegratorKind::RayMarch,
@@ -229,28 +296,63 @@ pub fn prepare<'v>(
         ..Default::default()
     };
     settings.validate()?;
-    Ok((scene, settings))
+    Ok(settings)
 }
 
-pub fn run(args: &RenderArgs) -> CliResult {
+pub fn run(args: &RenderArgs, matches: &ArgMatches) -> CliResult {
+    if args.scene.file.extension().is_some_and(|e| e == "toml") {
+        return super::scene_render::run(args, matches);
+    }
+    let output = args
+        .output
+        .as_ref()
+        .ok_or("an output file is required: -o OUT.exr")?;
     let start = Instant::now();
-    let volume = load_volume(&args.scene.file, args.scene.grid.as_deref())?;
+    let (volume, bytes_read) = load_volume_counted(&args.scene.file, args.scene.grid.as_deref())?;
     let load_seconds = start.elapsed().as_secs_f64();
-    let (w, h) = args.scene.res;
-    let (scene, settings) = prepare(&args.scene, &volume)?;
-    let rendered = render(&scene, &settings);
-    write_exr(&args.output, &rendered.image)
-        .map_err(|e| format!("{}: {e}", args.output.display()))?;
-    if let Some(png) = &args.png {
-        write_png(png, &rendered.image, args.exposure)
+    let (scene, mut settings) = prepare(&args.scene, &volume)?;
+    settings.crop = args.crop;
+    settings.aovs = !args.aov.is_empty();
+    if let Some(c) = &args.crop {
+        c.validate(args.scene.res.0, args.scene.res.1)?;
+    }
+    let mut rendered = render(&scene, &settings);
+    rendered.stats.bytes_read = bytes_read;
+    rendered.stats.grids_loaded = 1;
+    let outputs = Outputs {
+        exr: output,
+        png: args.png.as_deref(),
+        exposure: args.exposure,
+        stats: args.stats.as_deref(),
+        aovs: &args.aov,
+    };
+    write_outputs(&rendered, &outputs, load_seconds)
+}
+
+/// Where a render goes.
+pub struct Outputs<'a> {
+    pub exr: &'a Path,
+    pub png: Option<&'a Path>,
+    pub exposure: f32,
+    pub stats: Option<&'a Path>,
+    pub aovs: &'a [Aov],
+}
+
+/// Writes the EXR (with AOV layers and a crop's data window), the PNG
+/// preview and the statistics, and prints a summary line.
+pub fn write_outputs(rendered: &Rendered, out: &Outputs, load_seconds: f64) -> CliResult {
+    write_exr_layers(out.exr, rendered, out.aovs)
+        .map_err(|e| format!("{}: {e}", out.exr.display()))?;
+    if let Some(png) = out.png {
+        write_png(png, &rendered.image, out.exposure)
             .map_err(|e| format!("{}: {e}", png.display()))?;
     }
     let s = &rendered.stats;
     eprintln!(
         "{}: {}x{} at {} spp in {:.2} s ({:.0} paths/s; {} real, {} null collisions; load {:.2} s)",
-        args.output.display(),
-        w,
-        h,
+        out.exr.display(),
+        s.width,
+        s.height,
         s.spp,
         s.wall_seconds,
         s.rays_per_second,
@@ -258,7 +360,7 @@ pub fn run(args: &RenderArgs) -> CliResult {
         s.null_collisions,
         load_seconds
     );
-    if let Some(path) = &args.stats {
+    if let Some(path) = out.stats {
         super::write_whole(path, s.to_json().as_bytes())?;
     }
     Ok(())

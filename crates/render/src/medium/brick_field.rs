@@ -20,6 +20,8 @@ pub struct BrickField<'v> {
     /// Density x voxels a cell's bounds may differ by before the hierarchy
     /// walk refines it (0: refine to the finest cells).
     split: f32,
+    /// Past this (density x voxels across a finest cell) the walk goes voxel by voxel.
+    voxel_split: f32,
     local_from_render: Mat4,
     bounds: (Vec3, Vec3),
     voxel_size: f32,
@@ -55,6 +57,7 @@ impl<'v> BrickField<'v> {
             volume,
             fixed: None,
             split: 0.0,
+            voxel_split: f32::INFINITY,
             local_from_render: local_from_render.as_mat4(),
             bounds: (lo, hi),
             voxel_size,
@@ -76,6 +79,13 @@ impl<'v> BrickField<'v> {
             extra_optical_depth / per_voxel
         } else {
             0.0
+        };
+        // Finest cells that would cost more than 16 extra null collisions
+        // (only ever at extreme density scales) are walked voxel by voxel.
+        self.voxel_split = if per_voxel > 0.0 {
+            16.0 / per_voxel
+        } else {
+            f32::INFINITY
         };
         self
     }
@@ -131,10 +141,14 @@ impl DensityField for BrickField<'_> {
         let o = self.local_from_render.transform_point3(origin);
         let d = self.local_from_render.transform_vector3(dir);
         match &self.fixed {
-            None => BrickSegments::Hierarchy(
-                self.volume
-                    .segments_with_split(o, d, t_min, t_max, self.split),
-            ),
+            None => BrickSegments::Hierarchy(self.volume.segments_with_split(
+                o,
+                d,
+                t_min,
+                t_max,
+                self.split,
+                self.voxel_split,
+            )),
             Some(grid) => BrickSegments::Fixed(grid.segments(o, d, t_min, t_max)),
         }
     }

@@ -1,0 +1,27 @@
+//! `cirrus merge OUT.exr TILE.exr...`: crop tiles into one image.
+
+use super::CliResult;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct MergeArgs {
+    /// The full-size EXR to write.
+    pub output: PathBuf,
+    /// Tiles written by `cirrus render --crop` of the same image; together
+    /// they must cover it exactly once.
+    #[arg(required = true)]
+    pub tiles: Vec<PathBuf>,
+}
+
+/// Copies every channel of every tile into place; the result is bit for
+/// bit the full render when the tiles were rendered with its seed.
+pub fn run(args: &MergeArgs) -> CliResult {
+    let tiles: Vec<&std::path::Path> = args.tiles.iter().map(|p| p.as_path()).collect();
+    cirrus_render::exr_layers::merge_tiles(&args.output, &tiles)?;
+    eprintln!(
+        "{}: merged {} tiles",
+        args.output.display(),
+        args.tiles.len()
+    );
+    Ok(())
+}

@@ -1,0 +1,168 @@
+//! Which volumes of a scene file must be loaded at all.
+//!
+//! The rule, exact (it never drops light the renderer could have found):
+//! a path reaches a volume only by a camera ray, by a shadow ray, or by a
+//! scattered ray from a volume it already reached. So a volume is loaded
+//! when
+//! 1. its world box meets the camera's frustum (of the crop window, if
+//!    any), or
+//! 2. paths may scatter and then travel in any direction: an environment
+//!    light (its shadow rays go everywhere), an emitting volume anywhere
+//!    (phase-sampled rays look for it), or more than one scattering event
+//!    allowed (`max_depth` unset or >= 2) -- then every volume is loaded;
+//!    or
+//! 3. with single scattering lit by the sun alone, its box meets the
+//!    shadow prism of a visible volume: the visible box swept toward the
+//!    sun (widened by the sun's angular radius).
+//!
+//! With `max_depth = 0` only visible volumes matter. The rule is tested on
+//! boxes (conservative: a box may be kept whose contents are not needed).
+
+use cirrus_render::ray::clip_to_box;
+use cirrus_render::{Camera, Crop, Lights};
+use glam::{DVec3, Vec3};
+
+/// An axis-aligned world box.
+pub type WorldBox = (DVec3, DVec3);
+
+/// Whether `b` (render space) meets the frustum of pixels `crop` of `camera`.
+pub fn in_frustum(camera: &Camera, crop: Crop, b: (Vec3, Vec3)) -> bool {
+    let (x0, y0, x1, y1) = (
+        crop.x0 as f32,
+        crop.y0 as f32,
+        crop.x1 as f32,
+        crop.y1 as f32,
+    );
+    let corner = |x, y| camera.ray(x, y).dir;
+    let centre = camera.ray(0.5 * (x0 + x1), 0.5 * (y0 + y1)).dir;
+    let rays = [
+        corner(x0, y0),
+        corner(x1, y0),
+        corner(x1, y1),
+        corner(x0, y1),
+    ];
+    let apex = camera.from();
+    for k in 0..4 {
+        // The side plane through the apex and two neighbouring corner rays,
+        // normal pointing into the frustum.
+        let mut n = rays[k].cross(rays[(k + 1) % 4]);
+        if n.dot(centre) < 0.0 {
+            n = -n;
+        }
+        let all_outside = (0..8).all(|i| {
+            let p = Vec3::new(
+                if i & 1 == 0 { b.0.x } else { b.1.x },
+                if i & 2 == 0 { b.0.y } else { b.1.y },
+                if i & 4 == 0 { b.0.z } else { b.1.z },
+            );
+            n.dot(p - apex) < 0.0
+        });
+        if all_outside {
+            return false;
+        }
+    }
+    true
+}
+
+/// Whether box `b` meets box `a` swept from its place toward the sun
+/// (direction `to_sun`), widened by `tan_half` per unit of distance.
+pub fn in_sun_prism(a: WorldBox, b: WorldBox, to_sun: DVec3, tan_half: f64) -> bool {
+    let (ca, ha) = (0.5 * (a.0 + a.1), 0.5 * (a.1 - a.0));
+    let cb = 0.5 * (b.0 + b.1);
+    let spread = tan_half * ((cb - ca).length() + ha.length() + (0.5 * (b.1 - b.0)).length());
+    // The moving box meets b iff its centre's ray meets b grown by a's half size.
+    let (lo, hi) = (b.0 - ha - spread, b.1 + ha + spread);
+    let rel = |p: DVec3| (p - ca).as_vec3();
+    clip_to_box(
+        Vec3::ZERO,
+        to_sun.as_vec3(),
+        rel(lo),
+        rel(hi),
+        0.0,
+        f32::INFINITY,
+    )
+    .is_some()
+}
+
+/// Which volumes to load; `visible[i]` says whether volume `i` meets the
+/// frustum. See the module doc for the rule.
+pub fn needed(
+    visible: &[bool],
+    boxes: &[WorldBox],
+    lights: &Lights,
+    any_emission: bool,
+    max_depth: Option<u32>,
+) -> Vec<bool> {
+    let n = visible.len();
+    if max_depth == Some(0) {
+        return visible.to_vec();
+    }
+    let scattered_anywhere =
+        lights.environment.is_some() || any_emission || max_depth.is_none_or(|d| d >= 2);
+    if scattered_anywhere {
+        return vec![true; n];
+    }
+    let Some(sun) = &lights.sun else {
+        return visible.to_vec();
+    };
+    let to_sun = -sun.direction().as_dvec3();
+    let tan_half = sun_half_angle_tan(sun);
+    (0..n)
+        .map(|i| {
+            visible[i]
+                || (0..n).any(|a| visible[a] && in_sun_prism(boxes[a], boxes[i], to_sun, tan_half))
+        })
+        .collect()
+}
+
+/// Tangent of the sun's angular radius (0 for a delta sun).
+fn sun_half_angle_tan(sun: &cirrus_render::Sun) -> f64 {
+    let omc = sun.one_minus_cos_half_angle() as f64;
+    let c = 1.0 - omc;
+    if c <= 0.0 {
+        f64::INFINITY
+    } else {
+        (omc * (2.0 - omc)).max(0.0).sqrt() / c
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sun_prism_reaches_along_the_sun_only() {
+        let a = (DVec3::splat(-1.0), DVec3::splat(1.0));
+        let above = (DVec3::new(-0.5, 10.0, -0.5), DVec3::new(0.5, 11.0, 0.5));
+        let beside = (DVec3::new(5.0, -1.0, -1.0), DVec3::new(6.0, 1.0, 1.0));
+        let up = DVec3::Y;
+        assert!(in_sun_prism(a, above, up, 0.0));
+        assert!(!in_sun_prism(a, beside, up, 0.0));
+        assert!(
+            !in_sun_prism(a, above, -up, 0.0),
+            "behind the sun's direction"
+        );
+    }
+
+    #[test]
+    fn frustum_keeps_what_the_camera_sees() {
+        let cam = Camera::new(Vec3::ZERO, -Vec3::Z, Vec3::Y, 40.0, 32, 32);
+        let full = Crop {
+            x0: 0,
+            y0: 0,
+            x1: 32,
+            y1: 32,
+        };
+        let ahead = (Vec3::new(-1.0, -1.0, -11.0), Vec3::new(1.0, 1.0, -9.0));
+        let behind = (Vec3::new(-1.0, -1.0, 9.0), Vec3::new(1.0, 1.0, 11.0));
+        let aside = (Vec3::new(30.0, -1.0, -11.0), Vec3::new(32.0, 1.0, -9.0));
+        assert!(in_frustum(&cam, full, ahead));
+        assert!(!in_frustum(&cam, full, behind));
+        assert!(!in_frustum(&cam, full, aside));
+        // A crop of the left half does not see a box on the right.
+        let left = Crop { x1: 16, ..full };
+        let right_box = (Vec3::new(2.0, -0.5, -11.0), Vec3::new(3.0, 0.5, -9.0));
+        assert!(in_frustum(&cam, full, right_box));
+        assert!(!in_frustum(&cam, left, right_box));
+    }
+}

@@ -1,0 +1,282 @@
+//! The scene file of `cirrus render SCENE.toml`: its schema and parser.
+//!
+//! Every table and field maps to a `cirrus render` flag (the README's
+//! "Scene files" section has the table); flags given on the command line
+//! override the file. Unknown keys and wrong types are errors that name
+//! the file, the key, and its line and column (serde's
+//! `deny_unknown_fields`; toml's errors carry the span).
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+/// A whole scene file.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    #[serde(default)]
+    pub output: OutputSpec,
+    #[serde(default)]
+    pub render: RenderSpec,
+    #[serde(default)]
+    pub camera: CameraSpec,
+    /// Absent: the `--sun-*` defaults; `enabled = false`: no sun.
+    pub sun: Option<SunSpec>,
+    /// Absent: the `--env-radiance` default.
+    pub environment: Option<EnvironmentSpec>,
+    #[serde(default, rename = "volume")]
+    pub volumes: Vec<VolumeSpec>,
+}
+
+/// `-o`, `--png`, `--exposure`, `--stats`, `--aov`, `--crop`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    pub exr: Option<PathBuf>,
+    pub png: Option<PathBuf>,
+    pub exposure: Option<f32>,
+    pub stats: Option<PathBuf>,
+    pub aov: Option<Vec<String>>,
+    /// `[x0, y0, x1, y1]`, pixels, half-open.
+    pub crop: Option<[u32; 4]>,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum IntegratorName {
+    Path,
+    Raymarch,
+    Raymarch2pass,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum TransmittanceName {
+    Ratio,
+    Residual,
+    TrackLength,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum MajorantName {
+    Hierarchy,
+    Global,
+}
+
+/// `--spp`, `--time`, `--seed`, `--integrator`, `--transmittance`,
+/// `--majorant`, `--max-depth`, `--step`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderSpec {
+    pub spp: Option<u32>,
+    pub time: Option<f64>,
+    pub seed: Option<u64>,
+    pub integrator: Option<IntegratorName>,
+    pub transmittance: Option<TransmittanceName>,
+    pub majorant: Option<MajorantName>,
+    pub max_depth: Option<u32>,
+    pub step: Option<f32>,
+}
+
+/// `--res`, `--camera-from`, `--camera-to`, `--camera-up`, `--fov`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    /// `"WxH"`, as the flag.
+    #[serde(default, deserialize_with = "resolution")]
+    pub res: Option<(u32, u32)>,
+    pub from: Option<[f64; 3]>,
+    pub to: Option<[f64; 3]>,
+    pub up: Option<[f32; 3]>,
+    pub fov: Option<f32>,
+}
+
+/// `--sun-dir`, `--sun-irradiance`, `--sun-angle`, `--no-sun`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunSpec {
+    pub enabled: Option<bool>,
+    /// The direction sunlight travels (from the sun toward the scene).
+    pub direction: Option<[f32; 3]>,
+    pub irradiance: Option<[f32; 3]>,
+    /// Angular diameter in degrees.
+    pub angle: Option<f32>,
+}
+
+/// `--env-radiance`, `--env-map`, `--env-rotation`, `--env-intensity`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentSpec {
+    /// Constant radiance (ignored when a map is given).
+    pub radiance: Option<[f32; 3]>,
+    /// Lat-long EXR, relative to the scene file.
+    pub map: Option<PathBuf>,
+    /// Degrees about +Y.
+    pub rotation: Option<f32>,
+    pub intensity: Option<f32>,
+}
+
+/// A number or an RGB triple.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum Colour {
+    Grey(f32),
+    Rgb([f32; 3]),
+}
+
+impl Colour {
+    pub fn rgb(self) -> [f32; 3] {
+        match self {
+            Colour::Grey(v) => [v; 3],
+            Colour::Rgb(c) => c,
+        }
+    }
+}
+
+/// One volume instance. `--grid`, `--density-scale`, `--albedo` and `--g`
+/// given on the command line apply to every volume.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VolumeSpec {
+    /// A .vdb, .nvdb or .cbrk file, relative to the scene file.
+    pub file: PathBuf,
+    /// Density grid name (default "density", else the first float grid).
+    pub density: Option<String>,
+    /// Temperature grid name: blackbody emission (see `blackbody`).
+    pub temperature: Option<String>,
+    /// Emission grid name: `value * emission_color * emission_scale`.
+    pub emission: Option<String>,
+    pub density_scale: Option<f32>,
+    pub albedo: Option<Colour>,
+    pub g: Option<f32>,
+    #[serde(default)]
+    pub transform: TransformSpec,
+    #[serde(default)]
+    pub blackbody: BlackbodySpec,
+    pub emission_color: Option<[f32; 3]>,
+    pub emission_scale: Option<f32>,
+}
+
+/// Object to world: scale, then rotate, then translate.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformSpec {
+    pub translate: Option<[f64; 3]>,
+    /// Axis-angle rotation.
+    pub rotate: Option<AxisAngle>,
+    /// Euler angles in degrees, applied about X, then Y, then Z
+    /// (exclusive with `rotate`).
+    pub euler: Option<[f64; 3]>,
+    /// Uniform (a number) or per axis.
+    pub scale: Option<ScaleSpec>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisAngle {
+    pub axis: [f64; 3],
+    pub degrees: f64,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum ScaleSpec {
+    Uniform(f64),
+    Axes([f64; 3]),
+}
+
+/// pbrt-v4's blackbody parameters: `Le = scale * Blackbody((T - offset) * temperature_scale)`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlackbodySpec {
+    pub scale: Option<f32>,
+    pub offset: Option<f32>,
+    pub temperature_scale: Option<f32>,
+}
+
+fn resolution<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(u32, u32)>, D::Error> {
+    let s = String::deserialize(d)?;
+    super::render::resolution(&s)
+        .map(Some)
+        .map_err(serde::de::Error::custom)
+}
+
+impl SceneFile {
+    /// Reads and parses `path`; errors name the file (toml's messages give
+    /// the line, column and key).
+    pub fn read(path: &Path) -> Result<SceneFile, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::parse(&text).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    pub fn parse(text: &str) -> Result<SceneFile, String> {
+        let file: SceneFile = toml::from_str(text).map_err(|e| e.to_string())?;
+        for (i, v) in file.volumes.iter().enumerate() {
+            if v.transform.rotate.is_some() && v.transform.euler.is_some() {
+                return Err(format!(
+                    "volume {} ({}): give `rotate` or `euler`, not both",
+                    i + 1,
+                    v.file.display()
+                ));
+            }
+        }
+        Ok(file)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_keys_and_wrong_types_name_the_key_and_line() {
+        let e = SceneFile::parse("[camera]\nfov = 30\nfocal = 2\n").unwrap_err();
+        assert!(e.contains("line 3") && e.contains("focal"), "{e}");
+        let e = SceneFile::parse("[render]\nspp = \"many\"\n").unwrap_err();
+        assert!(e.contains("line 2") && e.contains("spp"), "{e}");
+        let e = SceneFile::parse("[[volume]]\nfile = \"a.vdb\"\nalbedo = [1, 2]\n").unwrap_err();
+        assert!(e.contains("line 3") && e.contains("albedo"), "{e}");
+        let e = SceneFile::parse("[camera]\nres = \"12by4\"\n").unwrap_err();
+        assert!(e.contains("line 2") && e.contains("WxH"), "{e}");
+    }
+
+    #[test]
+    fn a_full_scene_parses() {
+        let s = SceneFile::parse(
+            r#"
+            [output]
+            exr = "a.exr"
+            aov = ["albedo", "depth"]
+            crop = [0, 0, 8, 8]
+            [render]
+            spp = 4
+            integrator = "path"
+            transmittance = "track-length"
+            [camera]
+            res = "32x16"
+            from = [1, 2, 3]
+            to = [0, 0, 0]
+            [sun]
+            enabled = false
+            [environment]
+            map = "sky.exr"
+            rotation = 90
+            [[volume]]
+            file = "a.vdb"
+            albedo = [0.9, 0.8, 0.7]
+            transform = { translate = [1, 0, 0], rotate = { axis = [0, 1, 0], degrees = 45 }, scale = 2 }
+            [[volume]]
+            file = "b.vdb"
+            temperature = "temperature"
+            blackbody = { scale = 4, offset = 0, temperature_scale = 1000 }
+            "#,
+        )
+        .unwrap();
+        assert_eq!(s.volumes.len(), 2);
+        assert_eq!(s.camera.res, Some((32, 16)));
+        assert_eq!(s.render.transmittance, Some(TransmittanceName::TrackLength));
+        assert_eq!(s.volumes[0].albedo.unwrap().rgb(), [0.9, 0.8, 0.7]);
+        assert_eq!(s.volumes[1].blackbody.temperature_scale, Some(1000.0));
+    }
+}
