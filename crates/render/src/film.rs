@@ -1,11 +1,14 @@
 //! The film: per-pixel running mean and variance, split into tiles so rayon
 //! workers own disjoint pixels, and the resolved [`Image`].
 
-use crate::integrator::Sample;
+use glam::Vec3;
+
+use crate::integrator::{AovSample, Sample};
 use crate::stats::Counters;
 
-/// A finished image: per-pixel mean RGBA (alpha = 1 - camera-ray
-/// transmittance) and the sample variance of each channel's estimator.
+/// A finished image (or its crop window, see [`Rendered`](crate::Rendered)):
+/// per-pixel mean RGBA (alpha = 1 - camera-ray transmittance) and the
+/// sample variance of each channel's estimator.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
     pub width: u32,
@@ -58,13 +61,60 @@ impl PixelAccumulator {
     }
 }
 
-/// A rectangle of pixels owned by one task at a time.
+/// The compositing passes of an image (or of its crop window), row-major
+/// like [`Image::rgba`]. Each is the per-pixel mean of its
+/// [`AovSample`] part over all samples, except `depth`: the mean over the
+/// samples whose camera ray collided, and [`NO_DEPTH`] where none did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AovImage {
+    pub albedo: Vec<[f32; 3]>,
+    pub depth: Vec<f32>,
+    pub emission: Vec<[f32; 3]>,
+    pub direct: Vec<[f32; 3]>,
+    /// Samples taken per pixel.
+    pub samples: Vec<f32>,
+}
+
+/// Depth of a pixel no camera sample collided in (Blender's convention
+/// for the background of its Z pass).
+pub const NO_DEPTH: f32 = 1e10;
+
+/// Running means of the AOV parts of one pixel's samples.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct AovAccumulator {
+    n: u32,
+    albedo: Vec3,
+    emission: Vec3,
+    direct: Vec3,
+    hits: u32,
+    depth: f32,
+}
+
+impl AovAccumulator {
+    #[inline]
+    fn add(&mut self, a: &AovSample) {
+        self.n += 1;
+        let inv = 1.0 / self.n as f32;
+        self.albedo += (a.albedo - self.albedo) * inv;
+        self.emission += (a.emission - self.emission) * inv;
+        self.direct += (a.direct - self.direct) * inv;
+        if let Some(d) = a.depth.filter(|d| d.is_finite()) {
+            self.hits += 1;
+            self.depth += (d - self.depth) / self.hits as f32;
+        }
+    }
+}
+
+/// A rectangle of pixels owned by one task at a time; `x0, y0` are
+/// absolute image coordinates.
 pub(crate) struct Tile {
     pub x0: u32,
     pub y0: u32,
     pub w: u32,
     pub h: u32,
     pub pixels: Vec<PixelAccumulator>,
+    /// Empty unless the render keeps AOVs.
+    pub aovs: Vec<AovAccumulator>,
 }
 
 impl Tile {
@@ -80,37 +130,90 @@ impl Tile {
             c.nonfinite_samples += 1;
             [0.0; 4]
         };
-        self.pixels[(y * self.w + x) as usize].add(v);
+        let i = (y * self.w + x) as usize;
+        self.pixels[i].add(v);
+        if let Some(a) = self.aovs.get_mut(i) {
+            let finite =
+                s.aov.albedo.is_finite() && s.aov.emission.is_finite() && s.aov.direct.is_finite();
+            a.add(&if finite { s.aov } else { AovSample::default() });
+        }
     }
 }
 
+/// The pixels being rendered: the whole image or a crop window of it at
+/// `(x0, y0)`, `width x height` pixels.
 pub(crate) struct Film {
+    pub x0: u32,
+    pub y0: u32,
     pub width: u32,
     pub height: u32,
     pub tiles: Vec<Tile>,
+    pub aovs: bool,
 }
 
 impl Film {
-    pub fn new(width: u32, height: u32, tile: u32) -> Self {
+    /// Tiles of edge `tile` over the window; AOV accumulators if `aovs`.
+    pub fn new(x0: u32, y0: u32, width: u32, height: u32, tile: u32, aovs: bool) -> Self {
         let tile = tile.max(1);
         let mut tiles = Vec::new();
-        for y0 in (0..height).step_by(tile as usize) {
-            for x0 in (0..width).step_by(tile as usize) {
-                let (w, h) = (tile.min(width - x0), tile.min(height - y0));
+        for ty in (0..height).step_by(tile as usize) {
+            for tx in (0..width).step_by(tile as usize) {
+                let (w, h) = (tile.min(width - tx), tile.min(height - ty));
+                let n = (w * h) as usize;
                 tiles.push(Tile {
-                    x0,
-                    y0,
+                    x0: x0 + tx,
+                    y0: y0 + ty,
                     w,
                     h,
-                    pixels: vec![PixelAccumulator::default(); (w * h) as usize],
+                    pixels: vec![PixelAccumulator::default(); n],
+                    aovs: if aovs {
+                        vec![AovAccumulator::default(); n]
+                    } else {
+                        Vec::new()
+                    },
                 });
             }
         }
         Self {
+            x0,
+            y0,
             width,
             height,
             tiles,
+            aovs,
         }
+    }
+
+    /// The AOV passes so far (`None` unless the film keeps them).
+    pub fn resolve_aovs(&self) -> Option<AovImage> {
+        if !self.aovs {
+            return None;
+        }
+        let n = (self.width * self.height) as usize;
+        let mut out = AovImage {
+            albedo: vec![[0.0; 3]; n],
+            depth: vec![NO_DEPTH; n],
+            emission: vec![[0.0; 3]; n],
+            direct: vec![[0.0; 3]; n],
+            samples: vec![0.0; n],
+        };
+        for tile in &self.tiles {
+            for ty in 0..tile.h {
+                for tx in 0..tile.w {
+                    let a = &tile.aovs[(ty * tile.w + tx) as usize];
+                    let i =
+                        ((tile.y0 - self.y0 + ty) * self.width + tile.x0 - self.x0 + tx) as usize;
+                    out.albedo[i] = a.albedo.to_array();
+                    out.emission[i] = a.emission.to_array();
+                    out.direct[i] = a.direct.to_array();
+                    out.samples[i] = a.n as f32;
+                    if a.hits > 0 {
+                        out.depth[i] = a.depth;
+                    }
+                }
+            }
+        }
+        Some(out)
     }
 
     /// The image so far. Means are finite by construction (non-finite
@@ -124,7 +227,8 @@ impl Film {
             for ty in 0..tile.h {
                 for tx in 0..tile.w {
                     let acc = &tile.pixels[(ty * tile.w + tx) as usize];
-                    let i = ((tile.y0 + ty) * self.width + tile.x0 + tx) as usize;
+                    let i =
+                        ((tile.y0 - self.y0 + ty) * self.width + tile.x0 - self.x0 + tx) as usize;
                     let mut m = acc.mean;
                     if !m.iter().all(|x| x.is_finite()) {
                         c.nonfinite_samples += 1;

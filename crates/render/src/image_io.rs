@@ -80,7 +80,10 @@ pub fn srgb_encode(x: f32) -> f32 {
 
 /// Runs `write` on a temporary file next to `path`, syncs it and renames
 /// it to `path`; on any error the temporary file is removed.
-fn atomic_write(path: &Path, write: impl FnOnce(&File) -> io::Result<()>) -> io::Result<()> {
+pub(crate) fn atomic_write(
+    path: &Path,
+    write: impl FnOnce(&File) -> io::Result<()>,
+) -> io::Result<()> {
     let tmp = temp_path(path);
     let result = (|| {
         let file = File::create(&tmp)?;

@@ -17,16 +17,26 @@
 //!   [`TwoPassMarcher`] over a cached [`LightGrid`].
 //! - [`render()`] runs an integrator over tiles on rayon into a film of
 //!   per-pixel means and variances, for a sample count or a time budget,
-//!   and returns the [`Image`] with [`RenderStats`]. [`image_io`] writes EXR
-//!   and PNG files atomically.
-//! - [`Camera`], [`light`] (sun and environment) and the counter-based
+//!   and returns the [`Image`] with [`RenderStats`] (and AOVs, and where a
+//!   crop window sits). [`image_io`] writes EXR and PNG files atomically;
+//!   [`exr_layers`] writes AOV layers and crop data windows and merges tiles.
+//! - [`Media`] is what trackers and integrators walk: a lone [`Medium`], or
+//!   [`Volumes`], several instances under a top-level BVH whose extinction
+//!   and majorant segments add where they overlap, each with its own
+//!   albedo, phase and [`Emission`] ([`blackbody`] for temperature grids).
+//! - [`Camera`], [`light`] (sun and environment, constant or an
+//!   importance-sampled [`EnvMap`] over a [`distribution`]) and the counter-based
 //!   [`Rng`] in [`sampling`] are the supporting pieces. The RNG is keyed by
 //!   (seed, pixel, sample), which makes images independent of thread count.
 //!
 //! Coordinates are render space: world space minus an offset the caller
 //! picks so that f32 stays precise; lengths keep world units.
 
+pub mod blackbody;
 pub mod camera;
+pub mod distribution;
+pub mod env_map;
+pub mod exr_layers;
 pub mod film;
 pub mod image_io;
 pub mod integrator;
@@ -39,21 +49,26 @@ pub mod sampling;
 pub mod scene;
 pub mod stats;
 pub mod tracking;
+pub mod volumes;
 
+pub use blackbody::Blackbody;
 pub use camera::Camera;
-pub use film::Image;
+pub use env_map::EnvMap;
+pub use film::{AovImage, Image};
 pub use integrator::{
-    CameraSampler, IntegratorKind, LightGrid, LightGridSettings, PathTracer, RayMarcher, Sample,
-    TwoPassMarcher,
+    AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, PathTracer, RayMarcher,
+    Sample, TwoPassMarcher,
 };
 pub use light::{Environment, Lights, Sun};
 pub use medium::{
-    ConstantBox, DensityField, GlobalMajorant, GridField, MajorantGrid, MajorantSegment, Medium,
+    ConstantBox, DensityField, GlobalMajorant, GlobalMedia, GridField, Interaction, MajorantGrid,
+    MajorantSegment, Media, Medium,
 };
 pub use phase::HenyeyGreenstein;
 pub use ray::Ray;
-pub use render::{render, Rendered};
+pub use render::{render, render_media, Rendered, Window};
 pub use sampling::Rng;
-pub use scene::{Budget, MajorantMode, RenderSettings, Scene};
+pub use scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 pub use stats::{Counters, RenderStats};
 pub use tracking::TransmittanceEstimator;
+pub use volumes::{Emission, VolumeInstance, Volumes};

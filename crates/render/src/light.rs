@@ -1,10 +1,13 @@
-//! Lights at infinity: a directional sun (optionally a small disc) and a
-//! constant environment. Absent lights are `None` in [`Lights`] and cost
-//! nothing: no samples, no shadow rays.
+//! Lights at infinity: a directional sun (optionally a small disc) and an
+//! environment, constant or an importance-sampled HDR map. Absent lights
+//! are `None` in [`Lights`] and cost nothing: no samples, no shadow rays.
 
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 use glam::Vec3;
+
+use crate::env_map::EnvMap;
 
 use crate::sampling::{uniform_cone, uniform_sphere, UNIFORM_SPHERE_PDF};
 
@@ -62,6 +65,11 @@ impl Sun {
         self.irradiance
     }
 
+    /// `1 - cos` of the disc's angular radius (0 for a delta sun).
+    pub fn one_minus_cos_half_angle(&self) -> f32 {
+        self.one_minus_cos
+    }
+
     /// A delta light cannot be hit by a sampled direction, so it gets
     /// next-event estimation only and no MIS.
     pub fn is_delta(&self) -> bool {
@@ -98,30 +106,84 @@ impl Sun {
     }
 }
 
-/// A constant radiance arriving from every direction.
-#[derive(Clone, Copy, Debug)]
+/// Light arriving from every direction at infinity: a constant radiance,
+/// or an HDR [`EnvMap`] whose texels are multiplied by `radiance` (the
+/// map's intensity, per channel).
+#[derive(Clone, Debug)]
 pub struct Environment {
     pub radiance: Vec3,
+    pub map: Option<Arc<EnvMap>>,
 }
 
 impl Environment {
     pub fn new(radiance: Vec3) -> Self {
-        Self { radiance }
+        Self {
+            radiance,
+            map: None,
+        }
     }
 
-    /// Uniform sphere sampling: for a constant environment the only
-    /// light-side strategy there is; MIS with phase sampling adds the rest.
-    pub fn sample(&self, u1: f32, u2: f32) -> LightSample {
-        LightSample {
-            to_light: uniform_sphere(u1, u2),
-            radiance: self.radiance,
-            pdf: Some(UNIFORM_SPHERE_PDF),
+    /// An environment map scaled by `intensity`.
+    pub fn from_map(map: Arc<EnvMap>, intensity: Vec3) -> Self {
+        Self {
+            radiance: intensity,
+            map: Some(map),
         }
+    }
+
+    /// Samples a direction toward the sky: uniformly over the sphere for a
+    /// constant environment (the only light-side strategy there is; MIS
+    /// with phase sampling adds the rest), by the map's distribution for a
+    /// map.
+    #[inline]
+    pub fn sample(&self, u1: f32, u2: f32) -> LightSample {
+        match &self.map {
+            None => LightSample {
+                to_light: uniform_sphere(u1, u2),
+                radiance: self.radiance,
+                pdf: Some(UNIFORM_SPHERE_PDF),
+            },
+            Some(map) => {
+                let (to_light, l, pdf) = map.sample(u1, u2);
+                LightSample {
+                    to_light,
+                    radiance: l * self.radiance,
+                    pdf: Some(pdf),
+                }
+            }
+        }
+    }
+
+    /// Radiance along `dir` and the solid-angle density with which
+    /// [`sample`](Self::sample) would have picked it.
+    #[inline]
+    pub fn eval(&self, dir: Vec3) -> (Vec3, f32) {
+        match &self.map {
+            None => (self.radiance, UNIFORM_SPHERE_PDF),
+            Some(map) => {
+                let (l, pdf) = map.eval(dir);
+                (l * self.radiance, pdf)
+            }
+        }
+    }
+
+    /// Radiance averaged over the sphere (what the two-pass light grid,
+    /// which stores only the sky's transmittance, lights with).
+    pub fn mean_radiance(&self) -> Vec3 {
+        match &self.map {
+            None => self.radiance,
+            Some(map) => map.mean() * self.radiance,
+        }
+    }
+
+    /// Whether it delivers no light at all.
+    pub fn is_black(&self) -> bool {
+        self.radiance.max_element() <= 0.0 || self.map.as_ref().is_some_and(|m| m.is_black())
     }
 }
 
 /// The scene's lights; `None` means absent.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct Lights {
     pub sun: Option<Sun>,
     pub environment: Option<Environment>,
@@ -133,7 +195,7 @@ impl Lights {
     pub fn pruned(self) -> Self {
         Self {
             sun: self.sun.filter(|s| s.irradiance.max_element() > 0.0),
-            environment: self.environment.filter(|e| e.radiance.max_element() > 0.0),
+            environment: self.environment.filter(|e| !e.is_black()),
         }
     }
 }

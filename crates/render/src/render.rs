@@ -7,19 +7,35 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::film::{Film, Image};
+use crate::film::{AovImage, Film, Image};
 use crate::integrator::{
     CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
 };
-use crate::medium::{DensityField, Medium};
+use crate::light::Lights;
+use crate::medium::{DensityField, GlobalMedia, Media};
 use crate::sampling::Rng;
-use crate::scene::{Budget, MajorantMode, RenderSettings, Scene};
+use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 use crate::stats::{Counters, RenderStats};
 
 /// A finished render.
 pub struct Rendered {
+    /// The rendered pixels: the whole image, or the crop window.
     pub image: Image,
     pub stats: RenderStats,
+    /// Where `image` sits in the camera's full image.
+    pub window: Window,
+    /// The AOV passes over the same pixels, if the settings asked for them.
+    pub aovs: Option<AovImage>,
+}
+
+/// Placement of a rendered window in the full image (an EXR data window
+/// inside its display window).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Window {
+    pub x0: u32,
+    pub y0: u32,
+    pub full_width: u32,
+    pub full_height: u32,
 }
 
 /// Renders `scene` with `settings` on the ambient rayon pool (install a
@@ -29,31 +45,43 @@ pub struct Rendered {
 /// `Rng::new(seed, y * width + x, s)`, and each pixel accumulates its
 /// samples in order, so the image is bit-identical for any thread count.
 pub fn render<F: DensityField>(scene: &Scene<F>, settings: &RenderSettings) -> Rendered {
+    render_media(&scene.medium, &scene.camera, &scene.lights, settings)
+}
+
+/// [`render`] for any [`Media`]: a lone medium or several volume
+/// instances ([`Volumes`](crate::volumes::Volumes)).
+pub fn render_media<M: Media>(
+    media: &M,
+    camera: &Camera,
+    lights: &Lights,
+    settings: &RenderSettings,
+) -> Rendered {
     let start = Instant::now();
     match settings.majorant {
-        MajorantMode::Hierarchy => render_medium(scene, &scene.medium.by_ref(), settings, start),
+        MajorantMode::Hierarchy => render_with(media, camera, lights, settings, start),
         MajorantMode::Global => {
-            render_medium(scene, &scene.medium.with_global_majorant(), settings, start)
+            render_with(&GlobalMedia::new(media), camera, lights, settings, start)
         }
     }
 }
 
-fn render_medium<F: DensityField, G: DensityField>(
-    scene: &Scene<F>,
-    medium: &Medium<G>,
+fn render_with<M: Media>(
+    medium: &M,
+    camera: &Camera,
+    lights: &Lights,
     settings: &RenderSettings,
     start: Instant,
 ) -> Rendered {
     let mut counters = Counters::default();
-    let lights = scene.lights;
-    let (image, setup_seconds) = match settings.integrator {
+    let lights = lights.clone();
+    let (image, aovs, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
             let s = PathTracer::new(medium, lights, settings.transmittance, settings.max_depth);
-            (run(&s, &scene.camera, settings, start, &mut counters), 0.0)
+            run(&s, camera, settings, start, &mut counters)
         }
         IntegratorKind::RayMarch => {
             let s = RayMarcher::new(medium, lights, settings.step_voxels);
-            (run(&s, &scene.camera, settings, start, &mut counters), 0.0)
+            run(&s, camera, settings, start, &mut counters)
         }
         IntegratorKind::RayMarch2Pass => {
             let grid = LightGrid::build(
@@ -66,10 +94,8 @@ fn render_medium<F: DensityField, G: DensityField>(
             );
             let setup = start.elapsed().as_secs_f64();
             let s = TwoPassMarcher::new(medium, lights, &grid, settings.step_voxels);
-            (
-                run(&s, &scene.camera, settings, start, &mut counters),
-                setup,
-            )
+            let (image, aovs, _) = run(&s, camera, settings, start, &mut counters);
+            (image, aovs, setup)
         }
     };
     let wall_seconds = start.elapsed().as_secs_f64();
@@ -86,19 +112,61 @@ fn render_medium<F: DensityField, G: DensityField>(
     };
     stats.fill_counters(&counters);
     stats.rays_per_second = counters.paths as f64 / wall_seconds.max(1e-9);
-    Rendered { image, stats }
+    let crop = crop_of(settings, camera);
+    Rendered {
+        image,
+        stats,
+        window: Window {
+            x0: crop.x0,
+            y0: crop.y0,
+            full_width: camera.width(),
+            full_height: camera.height(),
+        },
+        aovs,
+    }
 }
 
-/// Runs sample passes until the budget is spent and resolves the film.
+/// The window to render: the settings' crop clamped to the image, or all.
+fn crop_of(settings: &RenderSettings, camera: &Camera) -> Crop {
+    let (w, h) = (camera.width(), camera.height());
+    match settings.crop {
+        Some(c) => {
+            let (x1, y1) = (c.x1.min(w), c.y1.min(h));
+            Crop {
+                x0: c.x0.min(x1.saturating_sub(1)),
+                y0: c.y0.min(y1.saturating_sub(1)),
+                x1: x1.max(1),
+                y1: y1.max(1),
+            }
+        }
+        None => Crop {
+            x0: 0,
+            y0: 0,
+            x1: w,
+            y1: h,
+        },
+    }
+}
+
+/// Runs sample passes until the budget is spent and resolves the film
+/// (and its AOVs); the third value is the setup time (none here).
 fn run<S: CameraSampler>(
     sampler: &S,
     camera: &Camera,
     settings: &RenderSettings,
     start: Instant,
     counters: &mut Counters,
-) -> Image {
-    let mut film = Film::new(camera.width(), camera.height(), settings.tile_size);
-    let progress = Progress::new(settings, camera);
+) -> (Image, Option<AovImage>, f64) {
+    let crop = crop_of(settings, camera);
+    let mut film = Film::new(
+        crop.x0,
+        crop.y0,
+        crop.x1 - crop.x0,
+        crop.y1 - crop.y0,
+        settings.tile_size,
+        settings.aovs,
+    );
+    let progress = Progress::new(settings, film.width, film.height);
     let mut spp = 0u32;
     match settings.budget {
         Budget::Spp(n) => {
@@ -140,7 +208,8 @@ fn run<S: CameraSampler>(
         }
     }
     progress.finish();
-    film.resolve(spp, counters)
+    let image = film.resolve(spp, counters);
+    (image, film.resolve_aovs(), 0.0)
 }
 
 /// One pass: samples `s0..s1` for every pixel, tiles in parallel.
@@ -153,7 +222,9 @@ fn pass<S: CameraSampler>(
     s1: u32,
     progress: &Progress,
 ) -> Counters {
-    let width = film.width;
+    // Random streams are keyed by the pixel's index in the full image, so
+    // a crop renders exactly the full render's values for its pixels.
+    let width = camera.width();
     film.tiles
         .par_iter_mut()
         .map(|tile| {
@@ -186,7 +257,7 @@ struct Progress {
 }
 
 impl Progress {
-    fn new(settings: &RenderSettings, camera: &Camera) -> Self {
+    fn new(settings: &RenderSettings, width: u32, height: u32) -> Self {
         let off = Self {
             bar: None,
             timed: None,
@@ -196,8 +267,7 @@ impl Progress {
         }
         let (len, timed) = match settings.budget {
             Budget::Spp(n) => {
-                let samples =
-                    u64::from(camera.width()) * u64::from(camera.height()) * u64::from(n.max(1));
+                let samples = u64::from(width) * u64::from(height) * u64::from(n.max(1));
                 (samples, None)
             }
             Budget::Time(s) => {

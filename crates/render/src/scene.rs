@@ -66,6 +66,33 @@ pub struct RenderSettings {
     pub tile_size: u32,
     /// Show a progress bar (only ever drawn when stderr is a terminal).
     pub progress: bool,
+    /// Render only this window of the camera's image (render farms); its
+    /// pixels are bit-identical to the same pixels of a full render.
+    pub crop: Option<Crop>,
+    /// Keep the AOV passes (albedo, depth, emission, direct, samples).
+    pub aovs: bool,
+}
+
+/// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl Crop {
+    /// Checks the window is non-empty and inside a `width x height` image.
+    pub fn validate(&self, width: u32, height: u32) -> Result<(), String> {
+        if self.x0 >= self.x1 || self.y0 >= self.y1 || self.x1 > width || self.y1 > height {
+            return Err(format!(
+                "crop {},{},{},{} must be a non-empty window x0 < x1 <= {width}, y0 < y1 <= {height}",
+                self.x0, self.y0, self.x1, self.y1
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl Default for RenderSettings {
@@ -81,6 +108,8 @@ impl Default for RenderSettings {
             light_grid: LightGridSettings::default(),
             tile_size: 16,
             progress: true,
+            crop: None,
+            aovs: false,
         }
     }
 }

@@ -30,6 +30,15 @@ pub struct Counters {
     pub majorant_violations: u64,
     /// Samples that came out NaN or infinite and were replaced by 0.
     pub nonfinite_samples: u64,
+    /// Emission grid lookups (temperature or emission) at collisions.
+    pub emission_lookups: u64,
+    /// Next-event shadow rays toward the sun...
+    pub nee_rays_sun: u64,
+    /// ...and toward the environment.
+    pub nee_rays_env: u64,
+    /// Times the environment was consulted: directions sampled from it
+    /// for next-event estimation, and escaped rays looking it up.
+    pub env_samples: u64,
 }
 
 impl AddAssign for Counters {
@@ -44,6 +53,10 @@ impl AddAssign for Counters {
         self.collision_cap_hits += o.collision_cap_hits;
         self.majorant_violations += o.majorant_violations;
         self.nonfinite_samples += o.nonfinite_samples;
+        self.emission_lookups += o.emission_lookups;
+        self.nee_rays_sun += o.nee_rays_sun;
+        self.nee_rays_env += o.nee_rays_env;
+        self.env_samples += o.env_samples;
     }
 }
 
@@ -79,6 +92,15 @@ pub struct RenderStats {
     pub collision_cap_hits: u64,
     pub majorant_violations: u64,
     pub nonfinite_samples: u64,
+    pub emission_lookups: u64,
+    pub nee_rays_sun: u64,
+    pub nee_rays_env: u64,
+    pub env_samples: u64,
+    /// Bytes read from volume files to build the scene (set by the caller
+    /// that loaded them; 0 when unknown).
+    pub bytes_read: u64,
+    /// Grids read from volume files (density, temperature, emission).
+    pub grids_loaded: u64,
     /// Camera paths per second of wall time.
     pub rays_per_second: f64,
 }
@@ -99,5 +121,9 @@ impl RenderStats {
         self.collision_cap_hits = c.collision_cap_hits;
         self.majorant_violations = c.majorant_violations;
         self.nonfinite_samples = c.nonfinite_samples;
+        self.emission_lookups = c.emission_lookups;
+        self.nee_rays_sun = c.nee_rays_sun;
+        self.nee_rays_env = c.nee_rays_env;
+        self.env_samples = c.env_samples;
     }
 }

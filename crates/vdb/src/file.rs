@@ -2,10 +2,11 @@
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::grid::{Grid, GridInfo};
-use crate::metadata::MetaMap;
+use crate::metadata::{meta_get, MetaMap, MetaValue};
 use crate::nanovdb::{self, NanoIndex};
 use crate::openvdb::{self, Archive};
 use crate::source::FileSource;
+use crate::transform::Transform;
 use std::path::Path;
 
 /// Which of the two formats a file is in.
@@ -28,6 +29,9 @@ enum Index {
     OpenVdb(Archive),
     NanoVdb(NanoIndex),
 }
+
+/// A grid's transform and inclusive index-space bounding box (min, max).
+pub type GridBounds = (Transform, [i32; 3], [i32; 3]);
 
 /// An open volume file: its grid list is read, its grid data is not.
 pub struct VolumeFile {
@@ -127,6 +131,31 @@ impl VolumeFile {
             Index::NanoVdb(n) => n.read_grid(&self.source, index),
         }
         .map_err(err)
+    }
+
+    /// The index-space bounding box (inclusive voxel coordinates) and the
+    /// transform of grid `index`, read from its header without its tree;
+    /// `None` when the file does not say (NanoVDB files, or OpenVDB grids
+    /// written without `file_bbox_min` / `file_bbox_max` metadata).
+    pub fn grid_bounds(&self, index: usize) -> Result<Option<GridBounds>> {
+        let err = |kind: ErrorKind| Error::new(self.path(), kind);
+        let count = self.grids().len();
+        if index >= count {
+            return Err(err(ErrorKind::NoSuchGrid(format!(
+                "#{index} (the file has {count})"
+            ))));
+        }
+        let Index::OpenVdb(a) = &self.index else {
+            return Ok(None);
+        };
+        let (meta, transform) = a.read_grid_header(&self.source, index).map_err(err)?;
+        let get = |key| match meta_get(&meta, key) {
+            Some(MetaValue::Vec3i(v)) => Some(*v),
+            _ => None,
+        };
+        Ok(get("file_bbox_min")
+            .zip(get("file_bbox_max"))
+            .map(|(lo, hi)| (transform, lo, hi)))
     }
 
     /// Index of the first grid called `name`; the unique stored name

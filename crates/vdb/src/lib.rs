@@ -31,7 +31,7 @@ mod value;
 
 pub use coord::{Coord, CoordBBox};
 pub use error::{Error, ErrorKind, Result};
-pub use file::{Format, VolumeFile};
+pub use file::{Format, GridBounds, VolumeFile};
 pub use grid::{Grid, GridClass, GridInfo, GridTree};
 pub use mask::BitMask;
 pub use metadata::{meta_get, MetaMap, MetaValue};

@@ -129,7 +129,10 @@ fn errors(image: &[[f32; 4]], reference: &[[f32; 4]]) -> (f64, f64) {
     (mse / n, rel / n)
 }
 
-fn read_exr_rgba(path: &Path) -> Result<(usize, usize, Vec<[f32; 4]>), Box<dyn std::error::Error>> {
+/// Width, height and RGBA pixels (row-major) of an image file.
+type RgbaImage = (usize, usize, Vec<[f32; 4]>);
+
+fn read_exr_rgba(path: &Path) -> Result<RgbaImage, Box<dyn std::error::Error>> {
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(
         path,
@@ -220,7 +223,7 @@ pub fn run(args: &ErrorArgs) -> CliResult {
                 &settings_for(
                     &c,
                     Budget::Time(args.reference_time),
-                    base.seed ^ 0x5EED_0F_2EF,
+                    base.seed ^ 0x5EED_F2EF,
                 ),
             );
             cirrus_render::image_io::write_exr(&args.out.join("reference.exr"), &r.image)?;

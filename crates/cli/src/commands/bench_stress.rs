@@ -198,7 +198,7 @@ fn cases() -> Vec<Case> {
         centre + Vec3::ONE,
         0.5,
     ));
-    let shell = cube(3 * N, 1.0).filter(|(c, _)| c.iter().any(|&x| x < N || x >= 2 * N));
+    let shell = cube(3 * N, 1.0).filter(|(c, _)| c.iter().any(|&x| !(N..2 * N).contains(&x)));
     v.push(plain(
         "camera in an empty region inside the volume",
         grid(shell, 1.0, DVec3::ZERO),

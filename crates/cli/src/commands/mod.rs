@@ -8,6 +8,7 @@ pub mod merge;
 pub mod render;
 pub mod scene_cull;
 pub mod scene_file;
+pub mod scene_load;
 pub mod scene_render;
 
 /// The error every subcommand returns: printed once by `main`.

@@ -6,7 +6,8 @@ use rayon::prelude::*;
 
 use super::march::{marched_transmittance, MIN_STEP_VOXELS};
 use crate::light::Lights;
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
+use crate::phase::HenyeyGreenstein;
 use crate::sampling::{from_local, Rng};
 use crate::stats::Counters;
 
@@ -65,19 +66,19 @@ impl LightGrid {
     /// non-empty bricks (in parallel; each point has its own random stream,
     /// so the grid is the same for any thread count). A sun with a disc is
     /// treated as a point at its centre here.
-    pub fn build<F: DensityField>(
-        medium: &Medium<F>,
+    pub fn build<M: Media>(
+        medium: &M,
         lights: &Lights,
         step_voxels: f32,
         settings: &LightGridSettings,
         seed: u64,
         c: &mut Counters,
     ) -> Self {
-        let lights = lights.pruned();
-        let voxel = medium.field.voxel_size();
+        let lights = lights.clone().pruned();
+        let voxel = medium.voxel_size();
         let cell = settings.cell_voxels.max(MIN_STEP_VOXELS) * voxel;
         let step = step_voxels.max(MIN_STEP_VOXELS) * voxel;
-        let (lo, hi) = medium.field.bounds();
+        let (lo, hi) = medium.bounds();
         let extent = (hi - lo).max(Vec3::ZERO);
         let points = [0, 1, 2].map(|a| (extent[a] / cell).ceil() as usize + 1);
         let bricks = points.map(|n| n.div_ceil(BRICK));
@@ -146,12 +147,7 @@ impl LightGrid {
     /// Whether any density lies near the brick: sampled at the lattice
     /// points one beyond the brick on every side and at the cell centres
     /// between them.
-    fn brick_occupied<F: DensityField>(
-        &self,
-        medium: &Medium<F>,
-        origin: [usize; 3],
-        c: &mut Counters,
-    ) -> bool {
+    fn brick_occupied<M: Media>(&self, medium: &M, origin: [usize; 3], c: &mut Counters) -> bool {
         let start = Vec3::new(origin[0] as f32, origin[1] as f32, origin[2] as f32) - 1.0;
         let n = 2 * (BRICK + 2) - 1; // points and centres at half-cell spacing
         for k in 0..n {
@@ -159,7 +155,7 @@ impl LightGrid {
                 for i in 0..n {
                     let q = start + 0.5 * Vec3::new(i as f32, j as f32, k as f32);
                     c.density_lookups += 1;
-                    if medium.field.density(self.lo + self.cell * q) > 0.0 {
+                    if medium.sigma_t(self.lo + self.cell * q) > 0.0 {
                         return true;
                     }
                 }
@@ -169,9 +165,9 @@ impl LightGrid {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn light_at<F: DensityField>(
+    fn light_at<M: Media>(
         &self,
-        medium: &Medium<F>,
+        medium: &M,
         lights: &Lights,
         q: [usize; 3],
         step: f32,
@@ -245,17 +241,25 @@ impl LightGrid {
 
     /// Phase-weighted direct light at `p` toward a ray travelling along
     /// `dir` (pass two's in-scattering term).
-    pub fn in_scatter<F>(&self, medium: &Medium<F>, lights: &Lights, p: Vec3, dir: Vec3) -> Vec3 {
+    /// A map environment lights with its mean radiance here: the grid
+    /// stores only the sky's transmittance (a biased baseline).
+    pub fn in_scatter(
+        &self,
+        phase: &HenyeyGreenstein,
+        lights: &Lights,
+        p: Vec3,
+        dir: Vec3,
+    ) -> Vec3 {
         let e = self.lookup(p);
         let mut s = Vec3::ZERO;
         if let Some(sun) = &lights.sun {
-            let f = medium.phase.eval(dir, -sun.direction());
+            let f = phase.eval(dir, -sun.direction());
             s += sun.irradiance() * (f * e[0]);
         }
         if let Some(env) = &lights.environment {
             let b = Vec3::new(e[2], e[3], e[4]);
-            let band = e[1] + 3.0 * medium.phase.g() * b.dot(dir);
-            s += env.radiance * band.max(0.0);
+            let band = e[1] + 3.0 * phase.g() * b.dot(dir);
+            s += env.mean_radiance() * band.max(0.0);
         }
         s
     }

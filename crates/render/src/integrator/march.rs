@@ -13,7 +13,8 @@ use glam::Vec3;
 
 use super::{escaped_radiance, Sample};
 use crate::light::Lights;
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
+use crate::phase::HenyeyGreenstein;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -28,8 +29,8 @@ pub const MIN_STEP_VOXELS: f32 = 1e-3;
 
 /// Calls `visit(t, sigma_t, counters)` at each jittered lattice point along
 /// `ray` within `[0, t_max]`; `visit` returns false to stop.
-pub(crate) fn march<F: DensityField>(
-    medium: &Medium<F>,
+pub(crate) fn march<M: Media>(
+    medium: &M,
     ray: &Ray,
     t_max: f32,
     h: f32,
@@ -39,7 +40,7 @@ pub(crate) fn march<F: DensityField>(
 ) {
     let mut origin = None;
     let mut next_k = 0i64;
-    for s in medium.field.segments(ray.origin, ray.dir, 0.0, t_max) {
+    for s in medium.majorants(ray.origin, ray.dir, 0.0, t_max) {
         c.dda_segments += 1;
         if s.majorant.is_nan() || s.majorant <= 0.0 {
             continue;
@@ -66,8 +67,8 @@ pub(crate) fn march<F: DensityField>(
 
 /// `exp(-tau)` with `tau` the jittered-march estimate of the optical depth
 /// from `p` toward `dir` (to infinity); counts one shadow ray.
-pub(crate) fn marched_transmittance<F: DensityField>(
-    medium: &Medium<F>,
+pub(crate) fn marched_transmittance<M: Media>(
+    medium: &M,
     p: Vec3,
     dir: Vec3,
     h: f32,
@@ -96,19 +97,24 @@ pub(crate) fn marched_transmittance<F: DensityField>(
 /// `L += T * (1 - exp(-sigma h)) * albedo * S(p)`, then `T *= exp(-sigma h)`
 /// (the step treated as homogeneous, which stays energy-conserving when a
 /// step is optically thick), where `in_scatter(p, dir)` returns `S`, the
-/// phase-weighted light arriving at `p`. The background is added through the
+/// phase-weighted light arriving at `p` for the given phase function. With
+/// several media the instance at each step is chosen with probability
+/// `sigma_t,i / sigma_t` (its albedo and phase are then unbiased for the
+/// mixture's); emission adds `(1 - albedo) * Le` to the step's source,
+/// the marched form of `sigma_a Le`. The background is added through the
 /// final `T`; `T` is Russian-rouletted like the trackers' estimates, so the
 /// march stops early in dense media without bias with respect to the march.
-pub(crate) fn march_camera_ray<F: DensityField>(
-    medium: &Medium<F>,
+pub(crate) fn march_camera_ray<M: Media>(
+    medium: &M,
     lights: &Lights,
     ray: &Ray,
     h: f32,
     rng: &mut Rng,
     c: &mut Counters,
-    mut in_scatter: impl FnMut(Vec3, &mut Rng, &mut Counters) -> Vec3,
+    mut in_scatter: impl FnMut(Vec3, &HenyeyGreenstein, &mut Rng, &mut Counters) -> Vec3,
 ) -> Sample {
     c.paths += 1;
+    let emits = medium.emits();
     let mut tr = 1.0f32;
     let mut l = Vec3::ZERO;
     let u = rng.uniform();
@@ -117,14 +123,20 @@ pub(crate) fn march_camera_ray<F: DensityField>(
             return true;
         }
         let step_tr = (-sigma * h).exp();
-        let s = in_scatter(ray.at(t), rng, c);
-        l += (tr * (1.0 - step_tr)) * medium.albedo * s;
+        let p = ray.at(t);
+        let it = medium.interaction(p, rng);
+        let mut source = it.albedo * in_scatter(p, &it.phase, rng, c);
+        if emits {
+            source += (Vec3::ONE - it.albedo) * medium.emission(p, it.instance, c);
+        }
+        l += (tr * (1.0 - step_tr)) * source;
         tr *= step_tr;
         roulette(&mut tr, rng)
     });
-    l += tr * escaped_radiance(lights, ray.dir, None);
+    l += tr * escaped_radiance(lights, ray.dir, None, c);
     Sample {
         radiance: l,
         alpha: 1.0 - tr,
+        ..Default::default()
     }
 }

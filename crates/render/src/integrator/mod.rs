@@ -23,7 +23,7 @@ use serde::Serialize;
 
 use crate::light::Lights;
 use crate::ray::Ray;
-use crate::sampling::{power_heuristic, Rng, UNIFORM_SPHERE_PDF};
+use crate::sampling::{power_heuristic, Rng};
 use crate::stats::Counters;
 
 /// Which integrator renders the image.
@@ -46,11 +46,31 @@ impl IntegratorKind {
     }
 }
 
-/// One camera sample's estimate: radiance, and `1 - T` of the camera ray.
+/// One camera sample's estimate: radiance, `1 - T` of the camera ray, and
+/// the parts the compositing passes (AOVs) show apart.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sample {
     pub radiance: Vec3,
     pub alpha: f32,
+    pub aov: AovSample,
+}
+
+/// The AOV parts of one sample (filled by the path tracer; the marchers
+/// leave them zero). Each is an unbiased estimate of its pass except
+/// `depth`, which is the sampled distance to the first real collision,
+/// `None` when the camera ray escaped (the film averages it over the
+/// samples that collided).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AovSample {
+    /// Albedo of the instance at the first real collision (0 if none).
+    pub albedo: Vec3,
+    pub depth: Option<f32>,
+    /// Emitted light alone (every vertex of the path).
+    pub emission: Vec3,
+    /// Light scattered once toward the camera: next-event estimation and
+    /// the MIS-weighted light hit by the phase-sampled ray at the first
+    /// scattering event (no background, no emission, no multiple scattering).
+    pub direct: Vec3,
 }
 
 /// Anything that turns a camera ray into a [`Sample`]; `Sync` so tiles can
@@ -66,11 +86,18 @@ pub trait CameraSampler: Sync {
 /// they take the full radiance). Otherwise each light's radiance is weighted
 /// by the power heuristic against that light's own sampling pdf, the
 /// counterpart of the weights in next-event estimation.
-pub(crate) fn escaped_radiance(lights: &Lights, dir: Vec3, phase_pdf: Option<f32>) -> Vec3 {
+pub(crate) fn escaped_radiance(
+    lights: &Lights,
+    dir: Vec3,
+    phase_pdf: Option<f32>,
+    c: &mut Counters,
+) -> Vec3 {
     let weight = |light_pdf: f32| phase_pdf.map_or(1.0, |p| power_heuristic(p, light_pdf));
     let mut l = Vec3::ZERO;
     if let Some(env) = &lights.environment {
-        l += env.radiance * weight(UNIFORM_SPHERE_PDF);
+        c.env_samples += 1;
+        let (radiance, pdf) = env.eval(dir);
+        l += radiance * weight(pdf);
     }
     if let Some((radiance, pdf)) = lights.sun.as_ref().and_then(|s| s.hit(dir)) {
         l += radiance * weight(pdf);

@@ -2,9 +2,10 @@
 
 use glam::Vec3;
 
-use super::{escaped_radiance, CameraSampler, Sample};
+use super::{escaped_radiance, AovSample, CameraSampler, Sample};
 use crate::light::{LightSample, Lights};
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
+use crate::phase::HenyeyGreenstein;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Rng};
 use crate::stats::Counters;
@@ -32,22 +33,33 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   light sampler and from HG sampling are combined with the power
 ///   heuristic (Veach 1997); a delta sun gets NEE only. At the last
 ///   allowed scattering event NEE takes weight 1 and the path stops, since
-///   the phase-sampled continuation could only reach lights at infinity.
+///   the phase-sampled continuation could only reach lights at infinity;
+///   unless the media emit, when it goes on to collect emission only.
 /// - `max_depth` counts scattering events: 0 shows only the environment
 ///   through the volume's transmittance, 1 is single scattering, `None`
 ///   is unlimited.
+/// - Several media: albedo and phase function are those of the instance
+///   chosen at the collision ([`Media::interaction`]).
 /// - Alpha is the track-length estimate of `1 - T` along the camera ray:
 ///   1 if its first free flight collides, else 0.
-pub struct PathTracer<'a, F> {
-    medium: &'a Medium<F>,
+/// - Emission: at every real collision, with the instance chosen with
+///   probability `sigma_t,i / sigma_t` ([`Media::interaction`]), the
+///   path adds `beta * (1 - albedo_i) * Le_i`. Delta tracking samples the
+///   collision with density `sigma_t T`, so this estimates
+///   `integral of T * sigma_a * Le` (the source term of the RTE), exactly
+///   as the albedo weight estimates the scattering term. Added before the
+///   depth test: emission is not a scattering event, so `max_depth` 0 shows
+///   the emitted light seen through the volume.
+pub struct PathTracer<'a, M> {
+    medium: &'a M,
     lights: Lights,
     estimator: TransmittanceEstimator,
     max_depth: Option<u32>,
 }
 
-impl<'a, F: DensityField> PathTracer<'a, F> {
+impl<'a, M: Media> PathTracer<'a, M> {
     pub fn new(
-        medium: &'a Medium<F>,
+        medium: &'a M,
         lights: Lights,
         estimator: TransmittanceEstimator,
         max_depth: Option<u32>,
@@ -65,6 +77,7 @@ impl<'a, F: DensityField> PathTracer<'a, F> {
         &self,
         p: Vec3,
         dir_in: Vec3,
+        phase: &HenyeyGreenstein,
         mis: bool,
         rng: &mut Rng,
         c: &mut Counters,
@@ -72,27 +85,33 @@ impl<'a, F: DensityField> PathTracer<'a, F> {
         let mut l = Vec3::ZERO;
         if let Some(sun) = &self.lights.sun {
             let s = sun.sample(rng.uniform(), rng.uniform());
-            l += self.light_term(p, dir_in, s, mis, rng, c);
+            c.nee_rays_sun += 1;
+            l += self.light_term(p, dir_in, phase, s, mis, rng, c);
         }
         if let Some(env) = &self.lights.environment {
             let s = env.sample(rng.uniform(), rng.uniform());
-            l += self.light_term(p, dir_in, s, mis, rng, c);
+            c.env_samples += 1;
+            // A zero-density sample (a pole) is dropped without a shadow ray.
+            c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
+            l += self.light_term(p, dir_in, phase, s, mis, rng, c);
         }
         l
     }
 
     /// `f * Li * T * w / p_light` for one light sample; for a delta light
     /// `radiance` is the irradiance and the pdf is a delta, so `f * E * T`.
+    #[allow(clippy::too_many_arguments)]
     fn light_term(
         &self,
         p: Vec3,
         dir_in: Vec3,
+        phase: &HenyeyGreenstein,
         s: LightSample,
         mis: bool,
         rng: &mut Rng,
         c: &mut Counters,
     ) -> Vec3 {
-        let f = self.medium.phase.eval(dir_in, s.to_light);
+        let f = phase.eval(dir_in, s.to_light);
         let weight = match s.pdf {
             None => f,
             Some(light_pdf) if light_pdf > 0.0 => {
@@ -112,46 +131,71 @@ impl<'a, F: DensityField> PathTracer<'a, F> {
     }
 }
 
-impl<F: DensityField> CameraSampler for PathTracer<'_, F> {
+impl<M: Media> CameraSampler for PathTracer<'_, M> {
     fn sample(&self, camera_ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
         c.paths += 1;
+        let emits = self.medium.emits();
         let mut ray = camera_ray;
         let mut beta = Vec3::ONE;
         let mut l = Vec3::ZERO;
         let mut alpha = 0.0;
+        let mut aov = AovSample::default();
         let mut depth = 0u32;
         let mut phase_pdf = None;
+        // Set after the last allowed scattering event when the media emit:
+        // the path goes on only to find emitted light, lights at infinity
+        // having had their full weight from next-event estimation.
+        let mut emission_only = false;
         loop {
             let flight = sample_free_flight(self.medium, &ray, f32::INFINITY, rng, c);
             if depth == 0 && flight != FreeFlight::Escaped {
                 alpha = 1.0;
             }
             let t = match flight {
+                FreeFlight::Escaped if emission_only => break,
                 FreeFlight::Escaped => {
-                    l += beta * escaped_radiance(&self.lights, ray.dir, phase_pdf);
+                    let e = beta * escaped_radiance(&self.lights, ray.dir, phase_pdf, c);
+                    l += e;
+                    if depth == 1 {
+                        aov.direct += e;
+                    }
                     break;
                 }
                 FreeFlight::Capped => break,
                 FreeFlight::Collision { t } => t,
             };
+            let p = ray.at(t);
+            let it = self.medium.interaction(p, rng);
+            if depth == 0 {
+                aov.albedo = it.albedo;
+                aov.depth = Some(t);
+            }
+            if emits {
+                let e = beta * (Vec3::ONE - it.albedo) * self.medium.emission(p, it.instance, c);
+                l += e;
+                aov.emission += e;
+            }
             if self.max_depth == Some(depth) {
                 break;
             }
             depth += 1;
-            beta *= self.medium.albedo;
+            beta *= it.albedo;
             if beta.max_element() <= 0.0 {
                 break;
             }
-            let p = ray.at(t);
             let last = self.max_depth == Some(depth);
-            l += beta * self.direct_light(p, ray.dir, !last, rng, c);
-            if last {
-                break;
+            let direct = beta * self.direct_light(p, ray.dir, &it.phase, !last, rng, c);
+            l += direct;
+            if depth == 1 {
+                aov.direct += direct;
             }
-            let (dir, pdf) = self
-                .medium
-                .phase
-                .sample(ray.dir, rng.uniform(), rng.uniform());
+            if last {
+                if !emits {
+                    break;
+                }
+                emission_only = true;
+            }
+            let (dir, pdf) = it.phase.sample(ray.dir, rng.uniform(), rng.uniform());
             phase_pdf = Some(pdf);
             ray = Ray::new(p, dir);
             if depth >= ROULETTE_MIN_DEPTH {
@@ -164,6 +208,10 @@ impl<F: DensityField> CameraSampler for PathTracer<'_, F> {
                 }
             }
         }
-        Sample { radiance: l, alpha }
+        Sample {
+            radiance: l,
+            alpha,
+            aov,
+        }
     }
 }

@@ -6,7 +6,8 @@ use glam::Vec3;
 use super::march::{march_camera_ray, marched_transmittance};
 use super::{CameraSampler, Sample};
 use crate::light::Lights;
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
+use crate::phase::HenyeyGreenstein;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -19,17 +20,17 @@ use crate::stats::Counters;
 /// along one HG-sampled direction (the phase-to-pdf ratio is then 1). It
 /// converges to the path tracer with `max_depth = 1` as the step shrinks.
 /// Cost per camera ray grows with the square of the number of steps.
-pub struct RayMarcher<'a, F> {
-    medium: &'a Medium<F>,
+pub struct RayMarcher<'a, M> {
+    medium: &'a M,
     lights: Lights,
     /// Step length in render-space units.
     step: f32,
 }
 
-impl<'a, F: DensityField> RayMarcher<'a, F> {
+impl<'a, M: Media> RayMarcher<'a, M> {
     /// `step_voxels` is converted with the field's smallest voxel size.
-    pub fn new(medium: &'a Medium<F>, lights: Lights, step_voxels: f32) -> Self {
-        let step = step_voxels.max(super::march::MIN_STEP_VOXELS) * medium.field.voxel_size();
+    pub fn new(medium: &'a M, lights: Lights, step_voxels: f32) -> Self {
+        let step = step_voxels.max(super::march::MIN_STEP_VOXELS) * medium.voxel_size();
         Self {
             medium,
             lights: lights.pruned(),
@@ -38,25 +39,33 @@ impl<'a, F: DensityField> RayMarcher<'a, F> {
     }
 
     /// Phase-weighted light arriving at `p` for a ray travelling along `dir`.
-    fn in_scatter(&self, p: Vec3, dir: Vec3, rng: &mut Rng, c: &mut Counters) -> Vec3 {
+    fn in_scatter(
+        &self,
+        p: Vec3,
+        dir: Vec3,
+        phase: &HenyeyGreenstein,
+        rng: &mut Rng,
+        c: &mut Counters,
+    ) -> Vec3 {
         let mut s = Vec3::ZERO;
         if let Some(sun) = &self.lights.sun {
             // Sampling the disc uniformly: radiance / pdf is the irradiance.
             let ls = sun.sample(rng.uniform(), rng.uniform());
-            let f = self.medium.phase.eval(dir, ls.to_light);
+            let f = phase.eval(dir, ls.to_light);
             let tr = marched_transmittance(self.medium, p, ls.to_light, self.step, rng, c);
             s += sun.irradiance() * (f * tr);
         }
         if let Some(env) = &self.lights.environment {
-            let (w, _) = self.medium.phase.sample(dir, rng.uniform(), rng.uniform());
+            let (w, _) = phase.sample(dir, rng.uniform(), rng.uniform());
             let tr = marched_transmittance(self.medium, p, w, self.step, rng, c);
-            s += env.radiance * tr;
+            c.env_samples += 1;
+            s += env.eval(w).0 * tr;
         }
         s
     }
 }
 
-impl<F: DensityField> CameraSampler for RayMarcher<'_, F> {
+impl<M: Media> CameraSampler for RayMarcher<'_, M> {
     fn sample(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
         march_camera_ray(
             self.medium,
@@ -65,7 +74,7 @@ impl<F: DensityField> CameraSampler for RayMarcher<'_, F> {
             self.step,
             rng,
             c,
-            |p, rng, c| self.in_scatter(p, ray.dir, rng, c),
+            |p, phase, rng, c| self.in_scatter(p, ray.dir, phase, rng, c),
         )
     }
 }

@@ -5,7 +5,7 @@ use super::light_grid::LightGrid;
 use super::march::{march_camera_ray, MIN_STEP_VOXELS};
 use super::{CameraSampler, Sample};
 use crate::light::Lights;
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -14,21 +14,16 @@ use crate::stats::Counters;
 /// [`LightGrid`] built once, instead of a shadow march per step: cost per
 /// camera ray is linear in its steps. Biased by the grid's resolution and
 /// the truncated angular expansion as well as by the step.
-pub struct TwoPassMarcher<'a, F> {
-    medium: &'a Medium<F>,
+pub struct TwoPassMarcher<'a, M> {
+    medium: &'a M,
     lights: Lights,
     grid: &'a LightGrid,
     step: f32,
 }
 
-impl<'a, F: DensityField> TwoPassMarcher<'a, F> {
-    pub fn new(
-        medium: &'a Medium<F>,
-        lights: Lights,
-        grid: &'a LightGrid,
-        step_voxels: f32,
-    ) -> Self {
-        let step = step_voxels.max(MIN_STEP_VOXELS) * medium.field.voxel_size();
+impl<'a, M: Media> TwoPassMarcher<'a, M> {
+    pub fn new(medium: &'a M, lights: Lights, grid: &'a LightGrid, step_voxels: f32) -> Self {
+        let step = step_voxels.max(MIN_STEP_VOXELS) * medium.voxel_size();
         Self {
             medium,
             lights: lights.pruned(),
@@ -38,7 +33,7 @@ impl<'a, F: DensityField> TwoPassMarcher<'a, F> {
     }
 }
 
-impl<F: DensityField> CameraSampler for TwoPassMarcher<'_, F> {
+impl<M: Media> CameraSampler for TwoPassMarcher<'_, M> {
     fn sample(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
         march_camera_ray(
             self.medium,
@@ -47,7 +42,7 @@ impl<F: DensityField> CameraSampler for TwoPassMarcher<'_, F> {
             self.step,
             rng,
             c,
-            |p, _, _| self.grid.in_scatter(self.medium, &self.lights, p, ray.dir),
+            |p, phase, _, _| self.grid.in_scatter(phase, &self.lights, p, ray.dir),
         )
     }
 }

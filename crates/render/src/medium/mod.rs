@@ -6,6 +6,8 @@
 //!   crate owns (tests and the fixed-grid baseline); `brick_field` adapts
 //!   the brick volumes of `cirrus-bricks`, placed in render space.
 //! - `global` collapses any field to one global majorant (Mitsuba-style).
+//! - `media` defines [`Media`], what the trackers and integrators walk: a
+//!   lone [`Medium`] or several volume instances, in extinction units.
 
 mod brick_field;
 mod constant_box;
@@ -13,6 +15,7 @@ mod field;
 mod global;
 mod grid_field;
 mod majorant_grid;
+mod media;
 
 pub use brick_field::{BrickField, BrickSegments};
 pub use constant_box::ConstantBox;
@@ -20,6 +23,7 @@ pub use field::{DensityField, MajorantSegment};
 pub use global::GlobalMajorant;
 pub use grid_field::GridField;
 pub use majorant_grid::{DdaSegments, MajorantGrid};
+pub use media::{GlobalMedia, Interaction, Media, Scaled};
 
 use glam::Vec3;
 

@@ -1,7 +1,7 @@
 //! Delta (Woodcock) tracking: unbiased free-flight sampling against local
 //! majorants.
 
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -33,15 +33,15 @@ pub enum FreeFlight {
 /// is accepted without a lookup: the same decision with the same random
 /// number, only cheaper (the control part of decomposition tracking, Kutz
 /// et al. 2017).
-pub fn sample_free_flight<F: DensityField>(
-    medium: &Medium<F>,
+pub fn sample_free_flight<M: Media>(
+    medium: &M,
     ray: &Ray,
     t_max: f32,
     rng: &mut Rng,
     c: &mut Counters,
 ) -> FreeFlight {
-    let segments = medium.field.segments(ray.origin, ray.dir, 0.0, t_max);
-    let mut walk = Walk::new(segments, medium.density_scale, false, rng);
+    let segments = medium.majorants(ray.origin, ray.dir, 0.0, t_max);
+    let mut walk = Walk::new(segments, false, rng);
     loop {
         match walk.next(rng, c) {
             Event::Enter(_) => {}

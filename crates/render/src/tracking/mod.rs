@@ -20,7 +20,7 @@ pub use track_length::track_length_transmittance;
 
 use serde::Serialize;
 
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -59,9 +59,9 @@ impl TransmittanceEstimator {
 
 /// Transmittance along `ray` over `[0, t_max]` by the chosen estimator;
 /// counts one shadow ray.
-pub fn transmittance<F: DensityField>(
+pub fn transmittance<M: Media>(
     estimator: TransmittanceEstimator,
-    medium: &Medium<F>,
+    medium: &M,
     ray: &Ray,
     t_max: f32,
     rng: &mut Rng,
@@ -99,8 +99,8 @@ pub(crate) fn roulette(tr: &mut f32, rng: &mut Rng) -> bool {
 /// Density lookup at a tentative collision, counted, with majorant
 /// violations (density above the segment's bound) counted too.
 #[inline]
-pub(crate) fn lookup<F: DensityField>(
-    medium: &Medium<F>,
+pub(crate) fn lookup<M: Media>(
+    medium: &M,
     ray: &Ray,
     t: f32,
     sigma_maj: f32,

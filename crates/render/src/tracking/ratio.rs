@@ -1,6 +1,6 @@
 //! Ratio tracking.
 
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -13,16 +13,16 @@ use super::{lookup, roulette};
 /// (1 - sigma_t / sigma_maj)`. A weight is clamped at 0 where the density
 /// exceeds its majorant (as pbrt-v4 clamps `sigma_n`), and the estimate is
 /// Russian-rouletted once small.
-pub fn ratio_tracking<F: DensityField>(
-    medium: &Medium<F>,
+pub fn ratio_tracking<M: Media>(
+    medium: &M,
     ray: &Ray,
     t_max: f32,
     rng: &mut Rng,
     c: &mut Counters,
 ) -> f32 {
     c.shadow_rays += 1;
-    let segments = medium.field.segments(ray.origin, ray.dir, 0.0, t_max);
-    let mut walk = Walk::new(segments, medium.density_scale, false, rng);
+    let segments = medium.majorants(ray.origin, ray.dir, 0.0, t_max);
+    let mut walk = Walk::new(segments, false, rng);
     let mut tr = 1.0f32;
     loop {
         match walk.next(rng, c) {

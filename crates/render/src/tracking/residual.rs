@@ -1,6 +1,6 @@
 //! Residual ratio tracking.
 
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -18,16 +18,16 @@ use super::{lookup, roulette};
 /// drawn at the residual rate `sigma_maj - sigma_c`. Where the segment is
 /// constant (`sigma_maj == sigma_c`) the residual rate is 0: no collisions,
 /// and the segment's transmittance is exact.
-pub fn residual_ratio_tracking<F: DensityField>(
-    medium: &Medium<F>,
+pub fn residual_ratio_tracking<M: Media>(
+    medium: &M,
     ray: &Ray,
     t_max: f32,
     rng: &mut Rng,
     c: &mut Counters,
 ) -> f32 {
     c.shadow_rays += 1;
-    let segments = medium.field.segments(ray.origin, ray.dir, 0.0, t_max);
-    let mut walk = Walk::new(segments, medium.density_scale, true, rng);
+    let segments = medium.majorants(ray.origin, ray.dir, 0.0, t_max);
+    let mut walk = Walk::new(segments, true, rng);
     let mut tr = 1.0f32;
     loop {
         match walk.next(rng, c) {

@@ -1,6 +1,6 @@
 //! The track-length transmittance estimator.
 
-use crate::medium::{DensityField, Medium};
+use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -11,8 +11,8 @@ use super::delta::{sample_free_flight, FreeFlight};
 /// Bernoulli variable with mean `T` (the escape probability). It stops at
 /// the first real collision, so it is cheap in dense media, but it has the
 /// largest variance of the three estimators (`T (1 - T)`).
-pub fn track_length_transmittance<F: DensityField>(
-    medium: &Medium<F>,
+pub fn track_length_transmittance<M: Media>(
+    medium: &M,
     ray: &Ray,
     t_max: f32,
     rng: &mut Rng,

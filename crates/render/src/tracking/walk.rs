@@ -7,7 +7,7 @@ use crate::stats::Counters;
 
 use super::MAX_COLLISIONS;
 
-/// A majorant segment scaled to extinction units, with the rate at which
+/// A majorant segment (extinction units) with the rate at which
 /// tentative collisions are placed on it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Segment {
@@ -40,7 +40,6 @@ pub(crate) enum Event {
 /// without drawing anything, the analytic skip of pbrt-v4's `SampleT_maj`.
 pub(crate) struct Walk<I> {
     segments: I,
-    scale: f32,
     residual: bool,
     current: Option<Segment>,
     t: f32,
@@ -49,10 +48,9 @@ pub(crate) struct Walk<I> {
 }
 
 impl<I: Iterator<Item = MajorantSegment>> Walk<I> {
-    pub fn new(segments: I, scale: f32, residual: bool, rng: &mut Rng) -> Self {
+    pub fn new(segments: I, residual: bool, rng: &mut Rng) -> Self {
         Self {
             segments,
-            scale,
             residual,
             current: None,
             t: 0.0,
@@ -69,7 +67,8 @@ impl<I: Iterator<Item = MajorantSegment>> Walk<I> {
                     return Event::End;
                 };
                 c.dda_segments += 1;
-                let (sigma_min, sigma_maj) = (self.scale * s.minorant, self.scale * s.majorant);
+                // Segments come in extinction units (`Media::majorants`).
+                let (sigma_min, sigma_maj) = (s.minorant, s.majorant);
                 let rate = if self.residual {
                     sigma_maj - sigma_min
                 } else {

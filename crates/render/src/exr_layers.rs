@@ -1,0 +1,285 @@
+//! EXR files with AOV layers and data windows, and the merge of crop tiles.
+//!
+//! Layout: one part, 32-bit float channels. `R, G, B, A` are the beauty
+//! (as [`write_exr`](crate::image_io::write_exr) writes it) and each AOV is
+//! a layer of channels named `layer.channel`, the convention Nuke and
+//! Blender read layers by: `albedo.R/G/B`, `depth.Z`, `emission.R/G/B`,
+//! `direct.R/G/B`, `samples.Y`. A crop is written at full size with a data
+//! window: the display window is the whole image, the data window only the
+//! crop (`layer_position` in the exr crate), so compositors place it.
+//!
+//! [`merge_tiles`] assembles such tiles channel by channel. Every value is
+//! copied, never recomputed, so the merge of crops rendered with the same
+//! seed is bit for bit the full render (the RNG is keyed by the pixel's
+//! index in the full image).
+
+use std::path::Path;
+
+use crate::film::AovImage;
+use crate::render::Rendered;
+
+/// The AOV layers a file can carry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Aov {
+    Albedo,
+    Depth,
+    Emission,
+    Direct,
+    Samples,
+}
+
+impl Aov {
+    pub const ALL: [Aov; 5] = [
+        Aov::Albedo,
+        Aov::Depth,
+        Aov::Emission,
+        Aov::Direct,
+        Aov::Samples,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Aov::Albedo => "albedo",
+            Aov::Depth => "depth",
+            Aov::Emission => "emission",
+            Aov::Direct => "direct",
+            Aov::Samples => "samples",
+        }
+    }
+
+    pub fn parse(s: &str) -> Result<Aov, String> {
+        Aov::ALL
+            .into_iter()
+            .find(|a| a.name() == s.trim())
+            .ok_or_else(|| {
+                format!("unknown AOV {s:?} (known: albedo, depth, emission, direct, samples)")
+            })
+    }
+
+    /// Channel names and values of this layer over the window's pixels.
+    fn channels(self, a: &AovImage) -> Vec<(String, Vec<f32>)> {
+        let rgb = |layer: &str, v: &[[f32; 3]]| {
+            ["R", "G", "B"]
+                .iter()
+                .enumerate()
+                .map(|(c, ch)| (format!("{layer}.{ch}"), v.iter().map(|p| p[c]).collect()))
+                .collect::<Vec<_>>()
+        };
+        match self {
+            Aov::Albedo => rgb("albedo", &a.albedo),
+            Aov::Emission => rgb("emission", &a.emission),
+            Aov::Direct => rgb("direct", &a.direct),
+            Aov::Depth => vec![("depth.Z".into(), a.depth.clone())],
+            Aov::Samples => vec![("samples.Y".into(), a.samples.clone())],
+        }
+    }
+}
+
+/// Writes a render as EXR: RGBA plus the requested AOV layers, in a data
+/// window when it is a crop. Atomic like every image written here.
+pub fn write_exr_layers(path: &Path, r: &Rendered, aovs: &[Aov]) -> std::io::Result<()> {
+    let img = &r.image;
+    let mut channels: Vec<(String, Vec<f32>)> = ["R", "G", "B", "A"]
+        .iter()
+        .enumerate()
+        .map(|(c, n)| (n.to_string(), img.rgba.iter().map(|p| p[c]).collect()))
+        .collect();
+    if let Some(a) = &r.aovs {
+        for aov in aovs {
+            channels.extend(aov.channels(a));
+        }
+    } else if !aovs.is_empty() {
+        return Err(std::io::Error::other(
+            "AOVs were asked for but the render did not keep them",
+        ));
+    }
+    let w = &r.window;
+    write_channels(
+        path,
+        (w.full_width as usize, w.full_height as usize),
+        (w.x0 as i32, w.y0 as i32),
+        (img.width as usize, img.height as usize),
+        channels,
+    )
+}
+
+/// Writes named f32 channels of a `size` data window at `position` inside
+/// a `full` display window.
+fn write_channels(
+    path: &Path,
+    full: (usize, usize),
+    position: (i32, i32),
+    size: (usize, usize),
+    channels: Vec<(String, Vec<f32>)>,
+) -> std::io::Result<()> {
+    use exr::prelude::*;
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+        .into_iter()
+        .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v)))
+        .collect();
+    let attributes = LayerAttributes {
+        layer_position: Vec2(position.0, position.1),
+        ..LayerAttributes::default()
+    };
+    let layer = Layer::new(
+        Vec2(size.0, size.1),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    let image = Image::new(
+        ImageAttributes::new(IntegerBounds::new(Vec2(0, 0), Vec2(full.0, full.1))),
+        layer,
+    );
+    crate::image_io::atomic_write(path, |file| {
+        image
+            .write()
+            .to_buffered(std::io::BufWriter::new(file))
+            .map_err(|e| std::io::Error::other(e.to_string()))
+    })
+}
+
+/// One tile read back: display size, data window and channels.
+struct Tile {
+    full: (usize, usize),
+    position: (i32, i32),
+    size: (usize, usize),
+    channels: Vec<(String, Vec<f32>)>,
+}
+
+fn read_tile(path: &Path) -> Result<Tile, String> {
+    use exr::prelude::*;
+    let err = |e: exr::error::Error| format!("{}: {e}", path.display());
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(err)?;
+    let dw = image.attributes.display_window;
+    if dw.position != Vec2(0, 0) {
+        return Err(format!(
+            "{}: display window must start at 0,0",
+            path.display()
+        ));
+    }
+    let layer = image.layer_data;
+    let channels = layer
+        .channel_data
+        .list
+        .into_iter()
+        .map(|c| {
+            let v = match c.sample_data {
+                FlatSamples::F32(v) => v,
+                FlatSamples::F16(v) => v.into_iter().map(|h| h.to_f32()).collect(),
+                FlatSamples::U32(v) => v.into_iter().map(|u| u as f32).collect(),
+            };
+            (c.name.to_string(), v)
+        })
+        .collect();
+    Ok(Tile {
+        full: (dw.size.0, dw.size.1),
+        position: (
+            layer.attributes.layer_position.0,
+            layer.attributes.layer_position.1,
+        ),
+        size: (layer.size.0, layer.size.1),
+        channels,
+    })
+}
+
+/// Assembles crop tiles into one full-size EXR. The tiles must share the
+/// display window and channel names, lie inside the image, not overlap,
+/// and cover it exactly; any violation is an error naming the file.
+pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<(), String> {
+    let first = tiles.first().ok_or("no tiles to merge")?;
+    let t0 = read_tile(first)?;
+    let (fw, fh) = t0.full;
+    let names: Vec<String> = t0.channels.iter().map(|(n, _)| n.clone()).collect();
+    let mut data: Vec<Vec<f32>> = vec![vec![0.0; fw * fh]; names.len()];
+    let mut covered = vec![false; fw * fh];
+    for (k, path) in tiles.iter().enumerate() {
+        let t = if k == 0 {
+            Tile {
+                channels: t0.channels.clone(),
+                ..t0
+            }
+        } else {
+            read_tile(path)?
+        };
+        let here = path.display();
+        if t.full != (fw, fh) {
+            return Err(format!(
+                "{here}: image is {}x{}, the first tile's is {fw}x{fh}",
+                t.full.0, t.full.1
+            ));
+        }
+        let tile_names: Vec<&String> = t.channels.iter().map(|(n, _)| n).collect();
+        if tile_names != names.iter().collect::<Vec<_>>() {
+            return Err(format!("{here}: channels differ from the first tile's"));
+        }
+        let (x0, y0) = t.position;
+        let (w, h) = t.size;
+        if x0 < 0 || y0 < 0 || x0 as usize + w > fw || y0 as usize + h > fh {
+            return Err(format!("{here}: data window lies outside the image"));
+        }
+        let (x0, y0) = (x0 as usize, y0 as usize);
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y0 + y) * fw + x0 + x;
+                if covered[i] {
+                    return Err(format!(
+                        "{here}: pixel ({}, {}) is in two tiles",
+                        x0 + x,
+                        y0 + y
+                    ));
+                }
+                covered[i] = true;
+            }
+        }
+        for (c, (_, v)) in t.channels.iter().enumerate() {
+            for y in 0..h {
+                let dst = (y0 + y) * fw + x0;
+                data[c][dst..dst + w].copy_from_slice(&v[y * w..(y + 1) * w]);
+            }
+        }
+    }
+    if let Some(i) = covered.iter().position(|c| !c) {
+        return Err(format!(
+            "the tiles leave pixel ({}, {}) uncovered",
+            i % fw,
+            i / fw
+        ));
+    }
+    write_channels(
+        out,
+        (fw, fh),
+        (0, 0),
+        (fw, fh),
+        names.into_iter().zip(data).collect(),
+    )
+    .map_err(|e| format!("{}: {e}", out.display()))
+}
+
+/// Every channel of an EXR's first layer over its data window, by name,
+/// with the window's position and size (for tests and tools).
+pub fn read_channels(path: &Path) -> Result<ExrChannels, String> {
+    let t = read_tile(path)?;
+    Ok(ExrChannels {
+        full: t.full,
+        position: t.position,
+        size: t.size,
+        channels: t.channels,
+    })
+}
+
+/// What [`read_channels`] returns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrChannels {
+    pub full: (usize, usize),
+    pub position: (i32, i32),
+    pub size: (usize, usize),
+    pub channels: Vec<(String, Vec<f32>)>,
+}

@@ -1,0 +1,201 @@
+//! [`Media`]: what the trackers and integrators need from whatever fills
+//! the scene, one [`Medium`] or several overlapping volume instances
+//! ([`Volumes`](crate::volumes::Volumes)).
+//!
+//! Extinction is the sum over the media present at a point, so the
+//! trackers only ever see one scalar field and its majorant segments, in
+//! extinction units (1 / render-space length). What differs between
+//! instances, albedo, phase function and emission, is asked for only at a
+//! real collision: [`Media::interaction`] picks the instance that scattered
+//! with probability `sigma_t,i / sigma_t`, which makes the mixture's
+//! scattering and emission terms unbiased (the collision-type selection of
+//! Novak et al. 2018, "Monte Carlo methods for volumetric light transport
+//! simulation", section 5.1, over instances instead of event types).
+
+use glam::Vec3;
+
+use super::field::{DensityField, MajorantSegment};
+use super::Medium;
+use crate::phase::HenyeyGreenstein;
+use crate::ray::clip_to_box;
+use crate::sampling::Rng;
+use crate::stats::Counters;
+
+/// What scatters (or emits) at a real collision.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interaction {
+    /// `sigma_s / sigma_t` of the chosen instance, per RGB channel.
+    pub albedo: Vec3,
+    pub phase: HenyeyGreenstein,
+    /// Index of the chosen instance (0 for a lone medium).
+    pub instance: u32,
+}
+
+/// The participating media of a scene, in render space.
+pub trait Media: Send + Sync {
+    type Majorants<'a>: Iterator<Item = MajorantSegment>
+    where
+        Self: 'a;
+
+    /// Front-to-back, disjoint majorant segments of the total extinction
+    /// along the ray within `[t_min, t_max]` (gaps: zero extinction), in
+    /// extinction units.
+    fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_>;
+
+    /// Total extinction coefficient at `p`.
+    fn sigma_t(&self, p: Vec3) -> f32;
+
+    /// Render-space bounds of where extinction may be non-zero.
+    fn bounds(&self) -> (Vec3, Vec3);
+
+    /// Smallest voxel size (ray-march steps are given in voxels).
+    fn voxel_size(&self) -> f32;
+
+    /// An upper bound of `sigma_t` everywhere (the global-majorant mode).
+    fn max_sigma_t(&self) -> f32;
+
+    /// The instance that a real collision at `p` belongs to, chosen with
+    /// probability `sigma_t,i(p) / sigma_t(p)`. Draws from `rng` only when
+    /// several instances overlap at `p`, so a lone medium's random streams
+    /// are those of the single-medium renderer.
+    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction;
+
+    /// Whether any instance emits; when false the integrators do no
+    /// emission work at all.
+    fn emits(&self) -> bool {
+        false
+    }
+
+    /// Emitted radiance `Le` of `instance` at `p` (the source term of the
+    /// radiative transfer equation is `sigma_a * Le`); counts its lookups.
+    fn emission(&self, _p: Vec3, _instance: u32, _c: &mut Counters) -> Vec3 {
+        Vec3::ZERO
+    }
+}
+
+/// A field's segments multiplied by a density scale.
+pub struct Scaled<I> {
+    inner: I,
+    scale: f32,
+}
+
+impl<I: Iterator<Item = MajorantSegment>> Iterator for Scaled<I> {
+    type Item = MajorantSegment;
+
+    #[inline]
+    fn next(&mut self) -> Option<MajorantSegment> {
+        let s = self.inner.next()?;
+        Some(MajorantSegment {
+            minorant: self.scale * s.minorant,
+            majorant: self.scale * s.majorant,
+            ..s
+        })
+    }
+}
+
+impl<I> Scaled<I> {
+    pub fn new(inner: I, scale: f32) -> Self {
+        Self { inner, scale }
+    }
+}
+
+/// A lone medium: one field, one material, no emission.
+impl<F: DensityField> Media for Medium<F> {
+    type Majorants<'a>
+        = Scaled<F::Segments<'a>>
+    where
+        Self: 'a;
+
+    #[inline]
+    fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_> {
+        Scaled::new(
+            self.field.segments(origin, dir, t_min, t_max),
+            self.density_scale,
+        )
+    }
+
+    #[inline]
+    fn sigma_t(&self, p: Vec3) -> f32 {
+        self.density_scale * self.field.density(p)
+    }
+
+    fn bounds(&self) -> (Vec3, Vec3) {
+        self.field.bounds()
+    }
+
+    fn voxel_size(&self) -> f32 {
+        self.field.voxel_size()
+    }
+
+    fn max_sigma_t(&self) -> f32 {
+        self.density_scale * self.field.global_majorant()
+    }
+
+    #[inline]
+    fn interaction(&self, _p: Vec3, _rng: &mut Rng) -> Interaction {
+        Interaction {
+            albedo: self.albedo,
+            phase: self.phase,
+            instance: 0,
+        }
+    }
+}
+
+/// Any media seen through one global majorant over their bounds (Mitsuba
+/// 3's `heterogeneous` medium; minorant 0, so residual ratio tracking
+/// degenerates to ratio tracking). The benchmarks' baseline.
+pub struct GlobalMedia<'m, M> {
+    inner: &'m M,
+    majorant: f32,
+}
+
+impl<'m, M: Media> GlobalMedia<'m, M> {
+    pub fn new(inner: &'m M) -> Self {
+        Self {
+            majorant: inner.max_sigma_t(),
+            inner,
+        }
+    }
+}
+
+impl<M: Media> Media for GlobalMedia<'_, M> {
+    type Majorants<'a>
+        = std::option::IntoIter<MajorantSegment>
+    where
+        Self: 'a;
+
+    fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_> {
+        let (lo, hi) = self.inner.bounds();
+        clip_to_box(origin, dir, lo, hi, t_min, t_max)
+            .filter(|(t0, t1)| t1 > t0 && self.majorant > 0.0)
+            .map(|(t0, t1)| MajorantSegment {
+                t0,
+                t1,
+                minorant: 0.0,
+                majorant: self.majorant,
+            })
+            .into_iter()
+    }
+
+    fn sigma_t(&self, p: Vec3) -> f32 {
+        self.inner.sigma_t(p)
+    }
+    fn bounds(&self) -> (Vec3, Vec3) {
+        self.inner.bounds()
+    }
+    fn voxel_size(&self) -> f32 {
+        self.inner.voxel_size()
+    }
+    fn max_sigma_t(&self) -> f32 {
+        self.majorant
+    }
+    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction {
+        self.inner.interaction(p, rng)
+    }
+    fn emits(&self) -> bool {
+        self.inner.emits()
+    }
+    fn emission(&self, p: Vec3, instance: u32, c: &mut Counters) -> Vec3 {
+        self.inner.emission(p, instance, c)
+    }
+}

@@ -1,0 +1,286 @@
+//! Several volume instances in one scene: [`Volumes`], the [`Media`] the
+//! scene files render.
+//!
+//! Each [`VolumeInstance`] is a density field already placed in render
+//! space (its object-to-world transform folded into the field, as
+//! [`BrickField`](crate::medium::BrickField) does), a density scale, an
+//! albedo, a Henyey-Greenstein `g`, and optional [`Emission`].
+//!
+//! - `bvh`: the top-level BVH (obvhs) that finds the instances a ray meets.
+//! - `merge`: where instances overlap, extinction and the majorant (and
+//!   minorant) segments add.
+//!
+//! Costs: one instance takes a fast path with no BVH and no merge (its own
+//! segments, scaled); a ray that misses every instance costs one box test;
+//! a ray through one instance walks that instance's segments alone.
+
+mod bvh;
+mod merge;
+
+pub use bvh::{Hit, Hits, TopLevel};
+pub use merge::Merged;
+
+use glam::Vec3;
+
+use crate::blackbody::Blackbody;
+use crate::medium::{DensityField, Interaction, MajorantSegment, Media, Scaled};
+use crate::phase::HenyeyGreenstein;
+use crate::sampling::Rng;
+use crate::stats::Counters;
+
+/// What an instance emits: blackbody radiation from a temperature grid,
+/// and/or a scalar emission grid times a colour. Each grid is its own
+/// field with its own bounds, so lookups happen only where it lives.
+pub struct Emission<F> {
+    pub temperature: Option<(F, Blackbody)>,
+    /// The grid and the colour its values multiply (scale included).
+    pub grid: Option<(F, Vec3)>,
+}
+
+impl<F: DensityField> Emission<F> {
+    /// Emitted radiance `Le` at `p`.
+    #[inline]
+    pub fn radiance(&self, p: Vec3, c: &mut Counters) -> Vec3 {
+        let inside = |f: &F| {
+            let (lo, hi) = f.bounds();
+            p.cmpge(lo).all() && p.cmple(hi).all()
+        };
+        let mut le = Vec3::ZERO;
+        if let Some((field, bb)) = &self.temperature {
+            if inside(field) {
+                c.emission_lookups += 1;
+                le += bb.radiance(field.density(p));
+            }
+        }
+        if let Some((field, colour)) = &self.grid {
+            if inside(field) {
+                c.emission_lookups += 1;
+                le += *colour * field.density(p).max(0.0);
+            }
+        }
+        le
+    }
+}
+
+/// One volume of a scene.
+pub struct VolumeInstance<F> {
+    pub density: F,
+    /// Extinction per unit density, in 1 / render-space units.
+    pub density_scale: f32,
+    pub albedo: Vec3,
+    pub phase: HenyeyGreenstein,
+    pub emission: Option<Emission<F>>,
+}
+
+impl<F: DensityField> VolumeInstance<F> {
+    pub fn new(density: F, density_scale: f32, albedo: Vec3, g: f32) -> Self {
+        Self {
+            density,
+            density_scale,
+            albedo,
+            phase: HenyeyGreenstein::new(g),
+            emission: None,
+        }
+    }
+
+    #[inline]
+    fn sigma_t(&self, p: Vec3) -> f32 {
+        self.density_scale * self.density.density(p)
+    }
+
+    fn interaction(&self, instance: usize) -> Interaction {
+        Interaction {
+            albedo: self.albedo,
+            phase: self.phase,
+            instance: instance as u32,
+        }
+    }
+}
+
+/// The instances of a scene with their top-level BVH.
+pub struct Volumes<F> {
+    instances: Vec<VolumeInstance<F>>,
+    top: TopLevel,
+    bounds: (Vec3, Vec3),
+    voxel_size: f32,
+    max_sigma_t: f32,
+    emits: bool,
+}
+
+impl<F: DensityField> Volumes<F> {
+    pub fn new(instances: Vec<VolumeInstance<F>>) -> Self {
+        let boxes: Vec<(Vec3, Vec3)> = instances.iter().map(|i| i.density.bounds()).collect();
+        let bounds = boxes.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &(a, b)| (lo.min(a), hi.max(b)),
+        );
+        let voxel_size = instances
+            .iter()
+            .map(|i| i.density.voxel_size())
+            .fold(f32::INFINITY, f32::min);
+        // Overlaps add, so the sum bounds sigma_t everywhere.
+        let max_sigma_t = instances
+            .iter()
+            .map(|i| i.density_scale * i.density.global_majorant())
+            .sum();
+        let emits = instances.iter().any(|i| i.emission.is_some());
+        Self {
+            top: TopLevel::new(boxes),
+            instances,
+            bounds,
+            voxel_size,
+            max_sigma_t,
+            emits,
+        }
+    }
+
+    pub fn instances(&self) -> &[VolumeInstance<F>] {
+        &self.instances
+    }
+
+    /// The instances the ray meets within `[t_min, t_max]`, by entry.
+    pub fn hits(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Hits {
+        self.top.hits(origin, dir, t_min, t_max)
+    }
+
+    fn instance_segments(&self, hit: &Hit, origin: Vec3, dir: Vec3) -> Scaled<F::Segments<'_>> {
+        let inst = &self.instances[hit.instance as usize];
+        Scaled::new(
+            inst.density.segments(origin, dir, hit.t0, hit.t1),
+            inst.density_scale,
+        )
+    }
+}
+
+/// Segments of [`Volumes`]: one instance's own, or the merge of several.
+pub enum VolumeSegments<'a, F: DensityField + 'a> {
+    None,
+    One(Scaled<F::Segments<'a>>),
+    Many(Merged<F::Segments<'a>>),
+}
+
+impl<'a, F: DensityField + 'a> Iterator for VolumeSegments<'a, F> {
+    type Item = MajorantSegment;
+
+    #[inline]
+    fn next(&mut self) -> Option<MajorantSegment> {
+        match self {
+            VolumeSegments::None => None,
+            VolumeSegments::One(s) => s.next(),
+            VolumeSegments::Many(m) => m.next(),
+        }
+    }
+}
+
+impl<F: DensityField> Media for Volumes<F> {
+    type Majorants<'a>
+        = VolumeSegments<'a, F>
+    where
+        Self: 'a;
+
+    fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_> {
+        match self.instances.len() {
+            0 => VolumeSegments::None,
+            // The fast path: no BVH, no merge; the field clips itself.
+            1 => {
+                let inst = &self.instances[0];
+                VolumeSegments::One(Scaled::new(
+                    inst.density.segments(origin, dir, t_min, t_max),
+                    inst.density_scale,
+                ))
+            }
+            _ => {
+                let hits = self.top.hits(origin, dir, t_min, t_max);
+                match hits.len() {
+                    0 => VolumeSegments::None,
+                    1 => VolumeSegments::One(self.instance_segments(&hits[0], origin, dir)),
+                    _ => VolumeSegments::Many(Merged::new(
+                        hits.iter().map(|h| self.instance_segments(h, origin, dir)),
+                    )),
+                }
+            }
+        }
+    }
+
+    #[inline]
+    fn sigma_t(&self, p: Vec3) -> f32 {
+        if self.instances.len() == 1 {
+            return self.instances[0].sigma_t(p);
+        }
+        let mut sigma = 0.0;
+        self.top
+            .containing(p, |i| sigma += self.instances[i].sigma_t(p));
+        sigma
+    }
+
+    fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    fn voxel_size(&self) -> f32 {
+        self.voxel_size
+    }
+
+    fn max_sigma_t(&self) -> f32 {
+        self.max_sigma_t
+    }
+
+    /// One instance: its material, no random number. Several: each
+    /// instance containing `p` with probability `sigma_t,i / sigma_t`; a
+    /// random number is drawn only when two or more have density there.
+    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction {
+        if self.instances.len() == 1 {
+            return self.instances[0].interaction(0);
+        }
+        let mut found: smallvec::SmallVec<[(usize, f32); 4]> = smallvec::SmallVec::new();
+        let mut total = 0.0;
+        self.top.containing(p, |i| {
+            let s = self.instances[i].sigma_t(p);
+            if s > 0.0 {
+                found.push((i, s));
+                total += s;
+            }
+        });
+        let chosen = match found.len() {
+            0 => {
+                // A collision accepted on a minorant where rounding put the
+                // lookup at 0: any instance containing p will do.
+                let mut first = 0;
+                let mut seen = false;
+                self.top.containing(p, |i| {
+                    if !seen {
+                        first = i;
+                        seen = true;
+                    }
+                });
+                first
+            }
+            1 => found[0].0,
+            _ => {
+                let mut x = rng.uniform() * total;
+                let mut pick = found[found.len() - 1].0;
+                for &(i, s) in &found {
+                    if x < s {
+                        pick = i;
+                        break;
+                    }
+                    x -= s;
+                }
+                pick
+            }
+        };
+        self.instances[chosen].interaction(chosen)
+    }
+
+    fn emits(&self) -> bool {
+        self.emits
+    }
+
+    #[inline]
+    fn emission(&self, p: Vec3, instance: u32, c: &mut Counters) -> Vec3 {
+        match &self.instances[instance as usize].emission {
+            Some(e) => e.radiance(p, c),
+            None => Vec3::ZERO,
+        }
+    }
+}
