@@ -3,8 +3,8 @@
 
 Usage (Debian's /usr/bin/python3 with pyopenvdb + mitsuba; see tools/README.md):
 
-    /usr/bin/python3 tools/peer_compare.py --out /tmp/peer            # everything, ~10 min on 2 cores
-    /usr/bin/python3 tools/peer_compare.py --out /tmp/peer --quick    # 1/8 of the samples, ~2 min
+    /usr/bin/python3 tools/peer_compare.py --out /tmp/peer            # everything, ~15 min on 2 idle cores
+    /usr/bin/python3 tools/peer_compare.py --out /tmp/peer --quick    # 1/8 of the samples, ~3 min
     /usr/bin/python3 tools/peer_compare.py --cases box cloud --skip-series
     /usr/bin/python3 tools/peer_compare.py --skip-cirrus              # the Mitsuba half only
 
