@@ -42,16 +42,15 @@ impl<F: DensityField> DensityField for GlobalMajorant<F> {
     }
 
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
-        let (lo, hi) = self.inner.bounds();
-        clip_to_box(origin, dir, lo, hi, t_min, t_max)
-            .filter(|(t0, t1)| t1 > t0 && self.majorant > 0.0)
-            .map(|(t0, t1)| MajorantSegment {
-                t0,
-                t1,
-                minorant: 0.0,
-                majorant: self.majorant,
-            })
-            .into_iter()
+        global_segment(
+            self.inner.bounds(),
+            self.majorant,
+            origin,
+            dir,
+            t_min,
+            t_max,
+        )
+        .into_iter()
     }
 
     fn global_majorant(&self) -> f32 {
@@ -61,4 +60,24 @@ impl<F: DensityField> DensityField for GlobalMajorant<F> {
     fn voxel_size(&self) -> f32 {
         self.inner.voxel_size()
     }
+}
+
+/// The one segment of a global majorant: the ray's overlap with `bounds`,
+/// or nothing when it misses or the majorant is zero.
+pub(crate) fn global_segment(
+    (lo, hi): (Vec3, Vec3),
+    majorant: f32,
+    origin: Vec3,
+    dir: Vec3,
+    t_min: f32,
+    t_max: f32,
+) -> Option<MajorantSegment> {
+    clip_to_box(origin, dir, lo, hi, t_min, t_max)
+        .filter(|(t0, t1)| t1 > t0 && majorant > 0.0)
+        .map(|(t0, t1)| MajorantSegment {
+            t0,
+            t1,
+            minorant: 0.0,
+            majorant,
+        })
 }

@@ -17,7 +17,6 @@ use glam::Vec3;
 use super::field::{DensityField, MajorantSegment};
 use super::Medium;
 use crate::phase::HenyeyGreenstein;
-use crate::ray::clip_to_box;
 use crate::sampling::Rng;
 use crate::stats::Counters;
 
@@ -165,16 +164,15 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
         Self: 'a;
 
     fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_> {
-        let (lo, hi) = self.inner.bounds();
-        clip_to_box(origin, dir, lo, hi, t_min, t_max)
-            .filter(|(t0, t1)| t1 > t0 && self.majorant > 0.0)
-            .map(|(t0, t1)| MajorantSegment {
-                t0,
-                t1,
-                minorant: 0.0,
-                majorant: self.majorant,
-            })
-            .into_iter()
+        super::global::global_segment(
+            self.inner.bounds(),
+            self.majorant,
+            origin,
+            dir,
+            t_min,
+            t_max,
+        )
+        .into_iter()
     }
 
     fn sigma_t(&self, p: Vec3) -> f32 {
