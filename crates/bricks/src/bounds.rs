@@ -55,6 +55,14 @@ impl BoundsLevel {
         (self.cells[i], self.cells[i + 1])
     }
 
+    /// (min, max) of a cell the caller knows to be inside the level.
+    #[inline]
+    pub fn get_inside(&self, c: [u32; 3]) -> (f32, f32) {
+        debug_assert!((0..3).all(|k| c[k] < self.dims[k]));
+        let i = 2 * self.index(c);
+        (self.cells[i], self.cells[i + 1])
+    }
+
     pub fn cell_count(&self) -> usize {
         self.dims.iter().map(|&d| d as usize).product()
     }

@@ -215,6 +215,7 @@ pub fn convert_tree(tree: &Tree<f32>, precision: Precision) -> Result<BrickVolum
         atlas,
         levels: Vec::new(),
         info,
+        finest_partition: Default::default(),
     };
     let level0 = brick_bounds(&volume);
     volume.levels = build_pyramid(level0);
@@ -240,6 +241,7 @@ fn empty_volume(precision: Precision, active_voxels: u64) -> BrickVolume {
             active_voxels,
             ..Default::default()
         },
+        finest_partition: Default::default(),
     }
 }
 

@@ -1,7 +1,10 @@
 //! Front-to-back majorant segments along a ray, from the bounds pyramid.
 //!
 //! At each step the walk finds the cell that contains the ray just past the
-//! current `t`, then looks at the pyramid from the coarsest level down:
+//! current `t`: the cell the pyramid would give looking from the coarsest
+//! level down, read from a [`CellPartition`] made once for the rule
+//! (`partition.rs`), so a step is a table read and a slab exit whatever the
+//! depth. The rule:
 //! - an empty cell (max 0) is skipped whole, at the coarsest level that is
 //!   empty, so empty space costs a step per coarse cell;
 //! - a uniform cell (min == max: a tile, a constant region) is one segment
@@ -18,7 +21,7 @@
 //! - otherwise the walk descends, down to 4^3 cells, which are always one
 //!   segment each.
 //!
-//! - at extreme optical thickness (the caller's `voxel_split`: a finest
+//! - at extreme optical thickness (the partition's `voxel_split`: a finest
 //!   cell whose bounds differ by that many density x voxels), the walk goes
 //!   down to single voxel cells bounded by their eight corners, so a steep
 //!   edge in a dense medium does not cost millions of null collisions.
@@ -35,6 +38,7 @@
 //! rounding: no infinite loop for rays along faces, edges or corners.
 
 use crate::bounds::CELL_LOG2;
+use crate::partition::CellPartition;
 use crate::volume::BrickVolume;
 use glam::Vec3;
 
@@ -53,6 +57,7 @@ pub struct RaySegment {
 /// Iterator of [`RaySegment`]s; see the module doc.
 pub struct SegmentIter<'a> {
     volume: &'a BrickVolume,
+    partition: &'a CellPartition,
     origin: Vec3,
     dir: Vec3,
     inv_dir: Vec3,
@@ -61,14 +66,8 @@ pub struct SegmentIter<'a> {
     pending: Option<RaySegment>,
     /// Pyramid steps taken (cells visited), for statistics.
     pub steps: u32,
-    /// Level of the last cell visited.
-    level: usize,
     /// Absolute part of the nudge: 1e-5 voxels along the ray's major axis.
     nudge_abs: f32,
-    /// Cells whose (max - min) x width in voxels is at most this are not refined.
-    split: f32,
-    /// Finest cells whose (max - min) x width exceeds this are walked voxel by voxel.
-    voxel_split: f32,
 }
 
 /// Slab test of a ray against the box [lo, hi]: the parameter interval inside.
@@ -82,7 +81,14 @@ pub fn ray_box(origin: Vec3, inv_dir: Vec3, lo: Vec3, hi: Vec3) -> (f32, f32) {
 }
 
 impl<'a> SegmentIter<'a> {
-    pub fn new(volume: &'a BrickVolume, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
+    pub fn new(
+        volume: &'a BrickVolume,
+        partition: &'a CellPartition,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> Self {
         let inv_dir = dir.recip();
         let (b0, b1) = ray_box(origin, inv_dir, Vec3::ZERO, volume.local_extent());
         // For exits: a zero component never exits (+inf, whatever the sign of zero).
@@ -95,6 +101,7 @@ impl<'a> SegmentIter<'a> {
         };
         SegmentIter {
             volume,
+            partition,
             origin,
             dir,
             inv_dir,
@@ -102,46 +109,40 @@ impl<'a> SegmentIter<'a> {
             t_end,
             pending: None,
             steps: 0,
-            level: 0,
             nudge_abs: 1e-5 / dir.abs().max_element(),
-            split: 0.0,
-            voxel_split: f32::INFINITY,
         }
     }
 
     /// The next raw (unmerged) segment, or `None` at the end of the ray.
     fn step(&mut self) -> Option<RaySegment> {
         let levels = &self.volume.levels;
-        let top = levels.len().saturating_sub(1);
         while self.t < self.t_end {
             self.steps += 1;
             let nudge = self.t.abs() * 1e-6 + self.nudge_abs;
             let p = self.origin + self.dir * (self.t + nudge);
             let voxel = p.floor().as_ivec3();
-            let bounds_at =
-                |l: usize| levels[l].get((voxel >> (CELL_LOG2 + l as u32) as i32).to_array());
-            // Start one level above where the last step ended: climb while the
-            // parent is empty (to skip empty space at the coarsest level),
-            // then descend to the first cell that is empty, tight enough, or
-            // finest. Starting low only ever gives finer (still valid) cells.
-            let mut l = (self.level + 1).min(top);
-            while l < top && bounds_at(l + 1).1 <= 0.0 {
-                l += 1;
-            }
-            let (mut lo, mut hi) = loop {
-                let (lo, hi) = bounds_at(l);
-                let width = (1u32 << (CELL_LOG2 + l as u32)) as f32;
-                if hi <= 0.0 || lo >= hi * TIGHT_ENOUGH || (hi - lo) * width <= self.split || l == 0
-                {
-                    break (lo, hi);
-                }
-                l -= 1;
-            };
-            self.level = l;
+            // The kept cell holding `p` (`partition.rs`): one table read. A
+            // point outside the volume (only ever by a nudge past its face)
+            // is in an empty level-0 cell.
+            let (l, (mut lo, mut hi)) =
+                match self.partition.level_at(voxel >> (CELL_LOG2 + 1) as i32) {
+                    // Level-l cells hold whole level-1 cells, and level 0 has
+                    // twice level 1's cells per axis: `voxel >> shift` is inside.
+                    Some(l) => (
+                        l,
+                        levels[l].get_inside(
+                            (voxel >> (CELL_LOG2 + l as u32) as i32)
+                                .as_uvec3()
+                                .to_array(),
+                        ),
+                    ),
+                    None => (0, (0.0, 0.0)),
+                };
+            let shift = (CELL_LOG2 + l as u32) as i32;
             // Exit through the cell's far faces (the near ones are behind us).
-            let mut size = (1i32 << (CELL_LOG2 + l as u32)) as f32;
-            let mut cell_lo = (voxel >> (CELL_LOG2 + l as u32) as i32).as_vec3() * size;
-            if l == 0 && hi > lo && (hi - lo) * size > self.voxel_split {
+            let mut size = (1i32 << shift) as f32;
+            let mut cell_lo = (voxel >> shift).as_vec3() * size;
+            if l == 0 && hi > lo && (hi - lo) * size > self.partition.voxel_split {
                 // A finest cell so optically thick that even its few voxels
                 // of slack cost many null collisions: bound the one voxel
                 // cell [v, v + 1) by its eight corner voxels instead.
@@ -191,28 +192,25 @@ impl Iterator for SegmentIter<'_> {
 
 impl BrickVolume {
     /// Majorant segments of the ray `origin + t * dir` (local index
-    /// coordinates) within `[t_min, t_max]`.
+    /// coordinates) within `[t_min, t_max]`, refined down to level-0 cells
+    /// wherever their bounds differ (split 0, no per-voxel cells).
     pub fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> SegmentIter<'_> {
-        SegmentIter::new(self, origin, dir, t_min, t_max)
+        let finest = self
+            .finest_partition
+            .get_or_init(|| self.partition(0.0, f32::INFINITY));
+        SegmentIter::new(self, finest, origin, dir, t_min, t_max)
     }
 
-    /// Segments that stop refining where a cell's bounds differ by at most
-    /// `split` density x voxels across its width, and walk finest cells
-    /// whose bounds differ by more than `voxel_split` voxel by voxel (see
-    /// the module doc).
-    pub fn segments_with_split(
-        &self,
+    /// Segments over the cells of `partition` (made by
+    /// [`BrickVolume::partition`] from this volume).
+    pub fn segments_in<'a>(
+        &'a self,
+        partition: &'a CellPartition,
         origin: Vec3,
         dir: Vec3,
         t_min: f32,
         t_max: f32,
-        split: f32,
-        voxel_split: f32,
-    ) -> SegmentIter<'_> {
-        SegmentIter {
-            split: split.max(0.0),
-            voxel_split,
-            ..SegmentIter::new(self, origin, dir, t_min, t_max)
-        }
+    ) -> SegmentIter<'a> {
+        SegmentIter::new(self, partition, origin, dir, t_min, t_max)
     }
 }

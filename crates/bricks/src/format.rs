@@ -320,5 +320,6 @@ pub fn read_cbrk(path: &Path) -> Result<BrickVolume, BrickError> {
         atlas,
         levels,
         info,
+        finest_partition: Default::default(),
     })
 }

@@ -7,7 +7,8 @@
 //! (min, max) bounds per brick and per coarser cell (`bounds.rs`) that bound
 //! the trilinearly interpolated density. [`SegmentIter`] (`dda.rs`) walks a
 //! ray through the pyramid front to back, skipping empty space at the
-//! coarsest level and yielding [`RaySegment`]s with tight bounds;
+//! coarsest level and yielding [`RaySegment`]s with tight bounds, over the
+//! cells of a [`CellPartition`] (`partition.rs`) fixed once per refinement rule;
 //! [`BrickVolume::trilinear`] is the density lookup. `format.rs` writes and
 //! memory-maps the `.cbrk` file of a converted volume, and `baseline.rs`
 //! builds the coarser majorant structures the benchmarks compare against.
@@ -19,6 +20,7 @@ mod dda;
 mod format;
 mod layout;
 pub mod measure;
+mod partition;
 mod section;
 mod volume;
 
@@ -28,6 +30,7 @@ pub use convert::{convert, convert_tree, MAX_MAP_BRICKS};
 pub use dda::{ray_box, RaySegment, SegmentIter, TIGHT_ENOUGH};
 pub use format::{read_cbrk, write_cbrk};
 pub use layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS};
+pub use partition::CellPartition;
 pub use section::Section;
 pub use volume::{Atlas, BrickVolume, SourceInfo};
 

@@ -3,8 +3,10 @@
 
 use crate::bounds::BoundsLevel;
 use crate::layout::{voxel_offset, BrickRef, Precision, BRICK_LOG2};
+use crate::partition::CellPartition;
 use crate::section::Section;
 use glam::{DMat4, IVec3, Vec3};
+use std::sync::OnceLock;
 
 /// Voxel storage of the stored bricks, at their precision.
 #[derive(Clone, Debug)]
@@ -62,9 +64,12 @@ pub struct BrickVolume {
     /// Per stored brick (lo, step) for u8 bricks; empty otherwise.
     pub(crate) ranges: Section<f32>,
     pub(crate) atlas: Atlas,
-    /// Level 0 = bricks; each next level halves the resolution.
+    /// Level 0 = 4^3 cells, level 1 = bricks; each next level halves the resolution.
     pub levels: Vec<BoundsLevel>,
     pub info: SourceInfo,
+    /// The partition of [`BrickVolume::segments`] (every cell refined), made
+    /// on first use.
+    pub(crate) finest_partition: OnceLock<CellPartition>,
 }
 
 impl BrickVolume {

@@ -1,7 +1,7 @@
 //! Property tests of conversion, lookups and the majorant walk against the
 //! reader's own tree (the independent reference).
 
-use cirrus_bricks::{convert_tree, BrickVolume, Precision, RaySegment};
+use cirrus_bricks::{convert_tree, BrickVolume, Precision, RaySegment, TIGHT_ENOUGH};
 use cirrus_vdb::{Coord, Tree};
 use glam::{IVec3, Vec3};
 use proptest::prelude::*;
@@ -97,9 +97,8 @@ fn check_ray(
     // The plain walk, a coarse one (cells refined only when their bounds
     // differ by over 2 density x voxels), and one that goes voxel by voxel.
     for (split, voxel_split) in [(0.0, f32::INFINITY), (2.0, f32::INFINITY), (0.0, 0.0)] {
-        let segs: Vec<RaySegment> = vol
-            .segments_with_split(lo, d, t_min, t_max, split, voxel_split)
-            .collect();
+        let cells = vol.partition(split, voxel_split);
+        let segs: Vec<RaySegment> = vol.segments_in(&cells, lo, d, t_min, t_max).collect();
         check_segments(tree, o, d, t_min, t_max, samples, &segs);
     }
 }
@@ -174,6 +173,40 @@ proptest! {
         let d = Vec3::from(d);
         prop_assume!(d.length() > 1e-3);
         check_ray(&vol, &tree, Vec3::from(o), d, 0.0, 200.0, &samples);
+    }
+
+    #[test]
+    fn partition_holds_the_cells_a_search_from_the_top_keeps(seed in 0u64..1000, split in prop::sample::select(vec![0.0f32, 0.5, 2.0, 8.0, 1e9])) {
+        // The rule searched level by level from the coarsest cell down, for
+        // every level-0 cell, against the table built once by recursion.
+        let tree = random_tree(seed, IVec3::new(3, -40, 17));
+        let vol = convert_tree(&tree, Precision::F32).unwrap();
+        let cells = vol.partition(split, f32::INFINITY);
+        let top = vol.levels.len() - 1;
+        let [dx, dy, dz] = vol.levels[0].dims;
+        let mut kept_levels = [0usize; 10];
+        for x in 0..dx as i32 {
+            for y in 0..dy as i32 {
+                for z in 0..dz as i32 {
+                    let c0 = IVec3::new(x, y, z);
+                    let mut l = top;
+                    loop {
+                        let (lo, hi) = vol.levels[l].get((c0 >> l as i32).to_array());
+                        let width = (4u32 << l) as f32;
+                        if l == 0 || hi <= 0.0 || lo >= hi * TIGHT_ENOUGH || (hi - lo) * width <= split {
+                            break;
+                        }
+                        l -= 1;
+                    }
+                    kept_levels[l] += 1;
+                    prop_assert_eq!(cells.level_at(c0 >> 1), Some(l), "level-0 cell {:?}, split {}", c0, split);
+                }
+            }
+        }
+        // The case is not trivial: some cells are kept below the top, and
+        // with an unbounded split only top cells are.
+        let below_top: usize = kept_levels[..top].iter().sum();
+        prop_assert_eq!(below_top == 0, split >= 1e9, "kept per level {:?}", kept_levels);
     }
 
     #[test]

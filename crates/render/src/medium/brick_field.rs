@@ -8,7 +8,9 @@
 //! the bricks' segments come back in the caller's `t`.
 
 use super::field::{DensityField, MajorantSegment};
-use cirrus_bricks::{BrickVolume, FixedGridIter, FixedMajorantGrid, RaySegment, SegmentIter};
+use cirrus_bricks::{
+    BrickVolume, CellPartition, FixedGridIter, FixedMajorantGrid, RaySegment, SegmentIter,
+};
 use glam::{DMat4, DVec3, Mat4, Vec3};
 
 /// A [`BrickVolume`] placed in render space.
@@ -17,11 +19,9 @@ pub struct BrickField<'v> {
     /// A pbrt-v4-style fixed majorant grid used instead of the hierarchy,
     /// for the benchmarks that compare the two.
     fixed: Option<FixedMajorantGrid>,
-    /// Density x voxels a cell's bounds may differ by before the hierarchy
-    /// walk refines it (0: refine to the finest cells).
-    split: f32,
-    /// Past this (density x voxels across a finest cell) the walk goes voxel by voxel.
-    voxel_split: f32,
+    /// The cells the hierarchy walk visits, made for the refinement rule of
+    /// [`BrickField::with_refinement`]; `None`: the finest cells.
+    partition: Option<CellPartition>,
     local_from_render: Mat4,
     bounds: (Vec3, Vec3),
     voxel_size: f32,
@@ -56,8 +56,7 @@ impl<'v> BrickField<'v> {
         BrickField {
             volume,
             fixed: None,
-            split: 0.0,
-            voxel_split: f32::INFINITY,
+            partition: None,
             local_from_render: local_from_render.as_mat4(),
             bounds: (lo, hi),
             voxel_size,
@@ -75,18 +74,16 @@ impl<'v> BrickField<'v> {
     /// from density to extinction per world unit.
     pub fn with_refinement(mut self, density_scale: f32, extra_optical_depth: f32) -> Self {
         let per_voxel = density_scale * self.voxel_size;
-        self.split = if per_voxel > 0.0 {
-            extra_optical_depth / per_voxel
+        // `split`: density x voxels a cell's bounds may differ by before the
+        // walk refines it. Finest cells that would cost more than 16 extra
+        // null collisions (only ever at extreme density scales) are walked
+        // voxel by voxel.
+        let (split, voxel_split) = if per_voxel > 0.0 {
+            (extra_optical_depth / per_voxel, 16.0 / per_voxel)
         } else {
-            0.0
+            (0.0, f32::INFINITY)
         };
-        // Finest cells that would cost more than 16 extra null collisions
-        // (only ever at extreme density scales) are walked voxel by voxel.
-        self.voxel_split = if per_voxel > 0.0 {
-            16.0 / per_voxel
-        } else {
-            f32::INFINITY
-        };
+        self.partition = Some(self.volume.partition(split, voxel_split));
         self
     }
 
@@ -140,16 +137,12 @@ impl DensityField for BrickField<'_> {
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
         let o = self.local_from_render.transform_point3(origin);
         let d = self.local_from_render.transform_vector3(dir);
-        match &self.fixed {
-            None => BrickSegments::Hierarchy(self.volume.segments_with_split(
-                o,
-                d,
-                t_min,
-                t_max,
-                self.split,
-                self.voxel_split,
-            )),
-            Some(grid) => BrickSegments::Fixed(grid.segments(o, d, t_min, t_max)),
+        match (&self.fixed, &self.partition) {
+            (None, Some(cells)) => {
+                BrickSegments::Hierarchy(self.volume.segments_in(cells, o, d, t_min, t_max))
+            }
+            (None, None) => BrickSegments::Hierarchy(self.volume.segments(o, d, t_min, t_max)),
+            (Some(grid), _) => BrickSegments::Fixed(grid.segments(o, d, t_min, t_max)),
         }
     }
 
