@@ -99,7 +99,7 @@ fn render_with<M: Media>(
         }
     };
     let wall_seconds = start.elapsed().as_secs_f64();
-    let mut stats = RenderStats {
+    let stats = RenderStats {
         integrator: settings.integrator.name().into(),
         transmittance: settings.transmittance.name().into(),
         majorant: settings.majorant.name().into(),
@@ -108,10 +108,10 @@ fn render_with<M: Media>(
         spp: image.spp,
         wall_seconds,
         setup_seconds,
+        counters,
+        rays_per_second: counters.paths as f64 / wall_seconds.max(1e-9),
         ..Default::default()
     };
-    stats.fill_counters(&counters);
-    stats.rays_per_second = counters.paths as f64 / wall_seconds.max(1e-9);
     let crop = crop_of(settings, camera);
     Rendered {
         image,

@@ -82,20 +82,9 @@ pub struct RenderStats {
     /// Part of `wall_seconds` spent before the first camera ray (the
     /// two-pass light grid).
     pub setup_seconds: f64,
-    pub paths: u64,
-    pub density_lookups: u64,
-    pub real_collisions: u64,
-    pub null_collisions: u64,
-    pub shadow_collisions: u64,
-    pub dda_segments: u64,
-    pub shadow_rays: u64,
-    pub collision_cap_hits: u64,
-    pub majorant_violations: u64,
-    pub nonfinite_samples: u64,
-    pub emission_lookups: u64,
-    pub nee_rays_sun: u64,
-    pub nee_rays_env: u64,
-    pub env_samples: u64,
+    /// What the integrators and trackers did (flattened into the JSON).
+    #[serde(flatten)]
+    pub counters: Counters,
     /// Bytes read from volume files to build the scene (set by the caller
     /// that loaded them; 0 when unknown).
     pub bytes_read: u64,
@@ -108,22 +97,5 @@ pub struct RenderStats {
 impl RenderStats {
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("stats serialise")
-    }
-
-    pub(crate) fn fill_counters(&mut self, c: &Counters) {
-        self.paths = c.paths;
-        self.density_lookups = c.density_lookups;
-        self.real_collisions = c.real_collisions;
-        self.null_collisions = c.null_collisions;
-        self.shadow_collisions = c.shadow_collisions;
-        self.dda_segments = c.dda_segments;
-        self.shadow_rays = c.shadow_rays;
-        self.collision_cap_hits = c.collision_cap_hits;
-        self.majorant_violations = c.majorant_violations;
-        self.nonfinite_samples = c.nonfinite_samples;
-        self.emission_lookups = c.emission_lookups;
-        self.nee_rays_sun = c.nee_rays_sun;
-        self.nee_rays_env = c.nee_rays_env;
-        self.env_samples = c.env_samples;
     }
 }

@@ -62,7 +62,7 @@ fn absorbing_box_matches_beer_lambert() {
     };
     let out = render(&scene, &common::settings(IntegratorKind::Path, spp, 17));
     assert_eq!(out.stats.spp, spp);
-    assert_eq!(out.stats.nonfinite_samples, 0);
+    assert_eq!(out.stats.counters.nonfinite_samples, 0);
 
     // Pixels whose four corners all hit the box lie entirely inside its
     // (convex) silhouette, so T varies continuously over their footprint

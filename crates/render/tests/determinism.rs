@@ -48,10 +48,13 @@ fn same_seed_same_image_for_any_thread_count() {
         assert_eq!(bits(&one), bits(&two), "{kind:?}: images differ");
         // Work counters are sums of per-tile integers: identical too.
         assert_eq!(
-            one.stats.density_lookups, two.stats.density_lookups,
+            one.stats.counters.density_lookups, two.stats.counters.density_lookups,
             "{kind:?}"
         );
-        assert_eq!(one.stats.shadow_rays, two.stats.shadow_rays, "{kind:?}");
+        assert_eq!(
+            one.stats.counters.shadow_rays, two.stats.counters.shadow_rays,
+            "{kind:?}"
+        );
         // A different seed changes the image.
         let other = render_with_threads(2, kind, 43);
         assert_ne!(bits(&one), bits(&other), "{kind:?}: seed ignored");
@@ -74,7 +77,7 @@ fn time_budget_reports_the_samples_it_reached() {
     settings.majorant = MajorantMode::Global;
     let out = render(&scene, &settings);
     assert!(out.stats.spp >= 1 && out.image.spp == out.stats.spp);
-    assert_eq!(out.stats.paths, 64 * u64::from(out.stats.spp));
+    assert_eq!(out.stats.counters.paths, 64 * u64::from(out.stats.spp));
     // Passes are sized to fit the budget; allow generous scheduling slack.
     assert!(
         out.stats.wall_seconds < 0.3 + 1.0,

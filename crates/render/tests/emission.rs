@@ -57,7 +57,7 @@ fn check(label: &str, emission: Emission<ConstantBox>, le: Vec3) {
     let mut settings = common::settings(IntegratorKind::Path, spp, 11);
     settings.aovs = true;
     let out = render_media(&volumes, &camera, &Lights::default(), &settings);
-    assert!(out.stats.emission_lookups > 0, "{label}");
+    assert!(out.stats.counters.emission_lookups > 0, "{label}");
     // All the light is emitted: the emission AOV is the beauty, exactly;
     // nothing is scattered; albedo 0; every pixel took every sample; and
     // a pixel's depth (mean sampled first-collision distance) lies on its
@@ -78,7 +78,10 @@ fn check(label: &str, emission: Emission<ConstantBox>, le: Vec3) {
             "{label}: depth {d} at pixel {i}"
         );
     }
-    assert_eq!(out.stats.shadow_rays, 0, "{label}: no lights, no NEE");
+    assert_eq!(
+        out.stats.counters.shadow_rays, 0,
+        "{label}: no lights, no NEE"
+    );
     let b = unit_box(1.0);
     let (mut z_sum, mut tested) = (0f64, 0usize);
     for y in 0..size {

@@ -46,7 +46,7 @@ fn a_constant_map_is_the_constant_environment() {
     );
     let a = render(&constant, &common::settings(IntegratorKind::Path, 64, 3));
     let b = render(&mapped, &common::settings(IntegratorKind::Path, 64, 4));
-    assert!(b.stats.env_samples > 0 && b.stats.nee_rays_env > 0);
+    assert!(b.stats.counters.env_samples > 0 && b.stats.counters.nee_rays_env > 0);
     assert_agree("constant map vs constant environment", &a.image, &b.image);
     // Pixels that miss the cloud see exactly the constant.
     assert_eq!(b.image.pixel(0, 0), [l.x, l.y, l.z, 0.0]);
@@ -83,6 +83,6 @@ fn one_bright_texel_is_the_equivalent_sun() {
     );
     let a = render(&with_sun, &common::settings(IntegratorKind::Path, 64, 5));
     let b = render(&with_map, &common::settings(IntegratorKind::Path, 64, 6));
-    assert_eq!(b.stats.nonfinite_samples, 0);
+    assert_eq!(b.stats.counters.nonfinite_samples, 0);
     assert_agree("one-texel map vs sun", &a.image, &b.image);
 }

@@ -24,7 +24,7 @@ fn transmittance_estimators_and_majorant_modes_converge_to_the_same_image() {
         s.majorant = majorant;
         let out = render(&scene, &s);
         assert_eq!(
-            out.stats.nonfinite_samples + out.stats.collision_cap_hits,
+            out.stats.counters.nonfinite_samples + out.stats.counters.collision_cap_hits,
             0
         );
         out.image

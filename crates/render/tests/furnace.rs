@@ -39,12 +39,12 @@ fn white_furnace_is_invisible() {
         let out = render(&scene, &settings);
         let label = format!("{estimator:?}/{majorant:?}/g={g}");
         assert_eq!(
-            out.stats.nonfinite_samples + out.stats.collision_cap_hits,
+            out.stats.counters.nonfinite_samples + out.stats.counters.collision_cap_hits,
             0,
             "{label}"
         );
         assert!(
-            out.stats.real_collisions > 1000,
+            out.stats.counters.real_collisions > 1000,
             "{label}: the medium must matter"
         );
 

@@ -97,10 +97,7 @@ fn assert_finite(
             out.image.rgba.iter().flatten().all(|x| x.is_finite()),
             "{label} {kind:?} {est:?}: non-finite pixel"
         );
-        let st = &out.stats;
-        total.nonfinite_samples += st.nonfinite_samples;
-        total.collision_cap_hits += st.collision_cap_hits;
-        total.majorant_violations += st.majorant_violations;
+        total += out.stats.counters;
     }
     total
 }

@@ -46,10 +46,13 @@ fn two_half_density_copies_render_as_one_full_copy() {
         let double = render_media(&copies, &scene.camera, &scene.lights, &settings);
         for out in [&single, &double] {
             assert_eq!(
-                out.stats.nonfinite_samples + out.stats.collision_cap_hits,
+                out.stats.counters.nonfinite_samples + out.stats.counters.collision_cap_hits,
                 0
             );
-            assert_eq!(out.stats.majorant_violations, 0, "merged majorants bound");
+            assert_eq!(
+                out.stats.counters.majorant_violations, 0,
+                "merged majorants bound"
+            );
         }
         let label = format!("two copies vs one ({estimator:?})");
         common::assert_pooled_agreement(
@@ -89,7 +92,10 @@ fn one_instance_is_the_lone_medium_bit_for_bit() {
     )]);
     let inst = render_media(&volumes, &scene.camera, &scene.lights, &settings);
     assert_eq!(lone.image, inst.image);
-    assert_eq!(lone.stats.density_lookups, inst.stats.density_lookups);
+    assert_eq!(
+        lone.stats.counters.density_lookups,
+        inst.stats.counters.density_lookups
+    );
 }
 
 /// Rays that miss every instance do no tracking: no segments, no lookups.
@@ -117,7 +123,7 @@ fn rays_that_miss_every_volume_do_no_work() {
         &lights(),
         &common::settings(IntegratorKind::Path, 4, 1),
     );
-    assert_eq!(out.stats.paths, 256);
-    assert_eq!(out.stats.dda_segments, 0);
-    assert_eq!(out.stats.density_lookups, 0);
+    assert_eq!(out.stats.counters.paths, 256);
+    assert_eq!(out.stats.counters.dda_segments, 0);
+    assert_eq!(out.stats.counters.density_lookups, 0);
 }

@@ -246,8 +246,10 @@ pub fn run(args: &ErrorArgs) -> CliResult {
                 mse,
                 rel_mse,
                 paths_per_s: s.rays_per_second,
-                lookups_per_path: s.density_lookups as f64 / s.paths.max(1) as f64,
-                null_per_real: s.null_collisions as f64 / s.real_collisions.max(1) as f64,
+                lookups_per_path: s.counters.density_lookups as f64
+                    / s.counters.paths.max(1) as f64,
+                null_per_real: s.counters.null_collisions as f64
+                    / s.counters.real_collisions.max(1) as f64,
             };
             eprintln!(
                 "{:<34} {:>5.2} s: {:>5} spp, RMSE {:.5}, relMSE {:.5}",
@@ -411,11 +413,17 @@ fn ceiling(s: &mut String, rows: &[Row], baseline: &str, lookup_ns: f64) {
         .filter(|r| Some(r.budget) == rows.last().map(|l| l.budget))
         .collect();
     let var = |r: &Row| r.mse * r.spp as f64;
-    let best_var = unbiased.iter().map(|r| var(r)).fold(f64::INFINITY, f64::min);
+    let best_var = unbiased
+        .iter()
+        .map(|r| var(r))
+        .fold(f64::INFINITY, f64::min);
     let var_gain = var(base) / best_var;
     let speedup = 1.0 / (1.0 - share).max(1e-9);
-    let _ = writeln!(s, "## The ceiling on this scene
-");
+    let _ = writeln!(
+        s,
+        "## The ceiling on this scene
+"
+    );
     let _ = writeln!(
         s,
         "- The baseline takes {:.1} density lookups per path at {lookup_ns:.1} ns each (one thread, measured in this run) out of {:.0} ns per path per thread: {:.0}% of its time.",

@@ -303,8 +303,10 @@ fn run_case(case: &Case) -> Result<(CaseResult, RenderStats), Box<dyn std::error
     let r = render(&scene, &settings);
     let finite = r.image.rgba.iter().all(|p| p.iter().all(|c| c.is_finite()));
     let s = r.stats.clone();
-    let collisions = (s.real_collisions + s.null_collisions + s.shadow_collisions) as f64
-        / s.paths.max(1) as f64;
+    let collisions = (s.counters.real_collisions
+        + s.counters.null_collisions
+        + s.counters.shadow_collisions) as f64
+        / s.counters.paths.max(1) as f64;
     let analytic = case.expected.map(|t| {
         let c = RES / 2;
         let measured = r.image.pixel(c, c)[0] as f64;
@@ -316,13 +318,14 @@ fn run_case(case: &Case) -> Result<(CaseResult, RenderStats), Box<dyn std::error
         let bound = 5.0 * (t * (1.0 - t) / case.spp as f64).sqrt() + chord + 1e-6;
         (measured, t, bound)
     });
-    let passed =
-        finite && s.collision_cap_hits == 0 && analytic.is_none_or(|(m, t, b)| (m - t).abs() <= b);
+    let passed = finite
+        && s.counters.collision_cap_hits == 0
+        && analytic.is_none_or(|(m, t, b)| (m - t).abs() <= b);
     Ok((
         CaseResult {
             name: case.name.clone(),
             finite,
-            collision_cap_hits: s.collision_cap_hits,
+            collision_cap_hits: s.counters.collision_cap_hits,
             max_collisions_per_path: collisions,
             analytic,
             sanitized_voxels: volume.info.sanitized_voxels,

@@ -356,8 +356,8 @@ pub fn write_outputs(rendered: &Rendered, out: &Outputs, load_seconds: f64) -> C
         s.spp,
         s.wall_seconds,
         s.rays_per_second,
-        s.real_collisions,
-        s.null_collisions,
+        s.counters.real_collisions,
+        s.counters.null_collisions,
         load_seconds
     );
     if let Some(path) = out.stats {
