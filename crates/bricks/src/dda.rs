@@ -38,7 +38,7 @@
 //! rounding: no infinite loop for rays along faces, edges or corners.
 
 use crate::bounds::CELL_LOG2;
-use crate::partition::CellPartition;
+use crate::partition::{Cell, CellPartition};
 use crate::volume::BrickVolume;
 use glam::Vec3;
 
@@ -121,23 +121,35 @@ impl<'a> SegmentIter<'a> {
             let nudge = self.t.abs() * 1e-6 + self.nudge_abs;
             let p = self.origin + self.dir * (self.t + nudge);
             let voxel = p.floor().as_ivec3();
-            // The kept cell holding `p` (`partition.rs`): one table read. A
-            // point outside the volume (only ever by a nudge past its face)
-            // is in an empty level-0 cell.
-            let (l, (mut lo, mut hi)) =
-                match self.partition.level_at(voxel >> (CELL_LOG2 + 1) as i32) {
-                    // Level-l cells hold whole level-1 cells, and level 0 has
-                    // twice level 1's cells per axis: `voxel >> shift` is inside.
-                    Some(l) => (
-                        l,
-                        levels[l].get_inside(
-                            (voxel >> (CELL_LOG2 + l as u32) as i32)
-                                .as_uvec3()
-                                .to_array(),
-                        ),
+            // The kept cell or empty cube holding `p` (`partition.rs`): one
+            // table read. A point outside the volume (only ever by a nudge
+            // past its face) is in an empty level-0 cell.
+            let c1 = voxel >> (CELL_LOG2 + 1) as i32;
+            let (l, (mut lo, mut hi)) = match self.partition.cell_at(c1) {
+                // Level-l cells hold whole level-1 cells, and level 0 has
+                // twice level 1's cells per axis: `voxel >> shift` is inside.
+                Some(Cell::Kept(l)) => (
+                    l,
+                    levels[l].get_inside(
+                        (voxel >> (CELL_LOG2 + l as u32) as i32)
+                            .as_uvec3()
+                            .to_array(),
                     ),
-                    None => (0, (0.0, 0.0)),
-                };
+                ),
+                Some(Cell::Empty { distance }) => {
+                    // Jump to the exit of the empty cube of level-1 cells
+                    // within `distance - 1` of this one.
+                    let r = distance as i32 - 1;
+                    let side = (1 << (CELL_LOG2 + 1)) as f32;
+                    let lo = (c1 - r).as_vec3() * side;
+                    let hi = (c1 + (r + 1)).as_vec3() * side;
+                    let far = Vec3::select(self.dir.cmpge(Vec3::ZERO), hi, lo);
+                    let exit = ((far - self.origin) * self.inv_dir).min_element();
+                    self.t = exit.max(self.t + nudge).min(self.t_end);
+                    continue;
+                }
+                None => (0, (0.0, 0.0)),
+            };
             let shift = (CELL_LOG2 + l as u32) as i32;
             // Exit through the cell's far faces (the near ones are behind us).
             let mut size = (1i32 << shift) as f32;

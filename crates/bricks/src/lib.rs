@@ -30,7 +30,7 @@ pub use convert::{convert, convert_tree, MAX_MAP_BRICKS};
 pub use dda::{ray_box, RaySegment, SegmentIter, TIGHT_ENOUGH};
 pub use format::{read_cbrk, write_cbrk};
 pub use layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS};
-pub use partition::CellPartition;
+pub use partition::{Cell, CellPartition};
 pub use section::Section;
 pub use volume::{Atlas, BrickVolume, SourceInfo};
 

@@ -10,19 +10,42 @@
 //! like the leaves of an octree, and the level of the leaf holding a point
 //! depends on the point alone.
 //!
-//! Layout: one `u8` per level-1 cell (8^3 voxels, one per brick), holding
-//! the level of the kept cell that contains it, or 0 when its eight level-0
-//! children are the kept cells. A table per level-0 cell would be eight
-//! times larger for no gain: level-0 cells need no decision. For the
-//! largest map the converter accepts (2^27 bricks) that is 128 MiB, as
-//! large as the brick map's refs / 4; for the corpus cloud it is 20 KiB.
+//! Empty space is crossed faster still. An empty level-1 cell stores its
+//! chessboard distance `d` (in level-1 cells, capped at 127) to the nearest
+//! level-1 cell holding density: every cell less than `d` away is empty,
+//! so the ray may jump to where it leaves that cube of `2d - 1` cells a side
+//! in one step, however the cube straddles the pyramid's aligned cells
+//! ("proximity clouds", Cohen and Sheffer 1994). Between the puffs of a
+//! cloudscape, or from a cloud's edge to its bounding box, that is a step or
+//! two where the aligned empty cells took tens.
+//!
+//! Layout: one `u8` per level-1 cell (8^3 voxels, one per brick): for a cell
+//! with density, the level of the kept cell that contains it, or 0 when its
+//! eight level-0 children are the kept cells; for an empty cell, `0x80 | d`.
+//! A table per level-0 cell would be eight times larger for no gain:
+//! level-0 cells need no decision. For the largest map the converter
+//! accepts (2^27 bricks) that is 128 MiB, as large as the brick map's refs /
+//! 4; for the corpus cloud it is 20 KiB.
 
 use crate::bounds::{BoundsLevel, CELL_LOG2};
 use crate::dda::TIGHT_ENOUGH;
 use crate::volume::BrickVolume;
 use glam::IVec3;
 
-/// Per level-1 cell, the level of the kept cell holding it (see the module doc).
+/// Flag of an empty level-1 cell's code; the low 7 bits are its distance.
+const EMPTY: u8 = 0x80;
+
+/// What the walk finds at a level-1 cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cell {
+    /// The cell holds density and lies in a kept cell of this level.
+    Kept(usize),
+    /// The cell is empty, and so is every level-1 cell at a chessboard
+    /// distance below `distance` (at least 1).
+    Empty { distance: u32 },
+}
+
+/// Per level-1 cell, the kept cell or the empty cube holding it (see the module doc).
 #[derive(Clone, Debug)]
 pub struct CellPartition {
     /// Level-1 cells per axis.
@@ -41,10 +64,10 @@ pub(crate) fn keep_whole(lo: f32, hi: f32, l: usize, split: f32) -> bool {
 }
 
 impl CellPartition {
-    /// Level of the kept cell holding level-1 cell `c`, or `None` outside
-    /// the volume.
+    /// The kept cell or empty cube holding level-1 cell `c`, or `None`
+    /// outside the volume.
     #[inline]
-    pub fn level_at(&self, c: IVec3) -> Option<usize> {
+    pub fn cell_at(&self, c: IVec3) -> Option<Cell> {
         let [dx, dy, dz] = self.dims;
         // Negative coordinates wrap to huge u32s and fail the same test.
         let (x, y, z) = (c.x as u32, c.y as u32, c.z as u32);
@@ -52,7 +75,14 @@ impl CellPartition {
             return None;
         }
         let i = (x as usize * dy as usize + y as usize) * dz as usize + z as usize;
-        Some(self.levels[i] as usize)
+        let code = self.levels[i];
+        Some(if code & EMPTY != 0 {
+            Cell::Empty {
+                distance: u32::from(code & !EMPTY),
+            }
+        } else {
+            Cell::Kept(code as usize)
+        })
     }
 
     /// Bytes of the table.
@@ -87,6 +117,9 @@ impl BrickVolume {
                 }
             }
         }
+        if top >= 1 {
+            mark_empty_distances(&self.levels[1], &mut table);
+        }
         CellPartition {
             dims,
             levels: table,
@@ -94,6 +127,74 @@ impl BrickVolume {
         }
     }
 }
+
+/// Replaces the code of every empty level-1 cell by `EMPTY | d`, with `d`
+/// its chessboard distance to the nearest cell with density, capped at 127
+/// (also where the volume has no density at all). The two-pass chamfer
+/// transform with unit weights over the 26 neighbours is exact for the
+/// chessboard metric (Rosenfeld and Pfaltz 1966).
+fn mark_empty_distances(level1: &BoundsLevel, table: &mut [u8]) {
+    const CAP: u8 = 127;
+    let [dx, dy, dz] = level1.dims.map(|d| d as i32);
+    let at = |x: i32, y: i32, z: i32| ((x * dy + y) * dz + z) as usize;
+    let mut dist: Vec<u8> = (0..table.len()).map(|_| CAP).collect();
+    for x in 0..dx {
+        for y in 0..dy {
+            for z in 0..dz {
+                if level1.get_inside([x as u32, y as u32, z as u32]).1 > 0.0 {
+                    dist[at(x, y, z)] = 0;
+                }
+            }
+        }
+    }
+    // Forward pass: neighbours earlier in x-major order; backward: later.
+    let mut relax = |x: i32, y: i32, z: i32, sign: i32| {
+        let mut best = dist[at(x, y, z)];
+        for (ox, oy, oz) in HALF_NEIGHBOURS {
+            let (nx, ny, nz) = (x + sign * ox, y + sign * oy, z + sign * oz);
+            if (0..dx).contains(&nx) && (0..dy).contains(&ny) && (0..dz).contains(&nz) {
+                best = best.min(dist[at(nx, ny, nz)].saturating_add(1).min(CAP));
+            }
+        }
+        dist[at(x, y, z)] = best;
+    };
+    for x in 0..dx {
+        for y in 0..dy {
+            for z in 0..dz {
+                relax(x, y, z, 1);
+            }
+        }
+    }
+    for x in (0..dx).rev() {
+        for y in (0..dy).rev() {
+            for z in (0..dz).rev() {
+                relax(x, y, z, -1);
+            }
+        }
+    }
+    for (code, d) in table.iter_mut().zip(dist) {
+        if d > 0 {
+            *code = EMPTY | d;
+        }
+    }
+}
+
+/// The 13 neighbours that come before a cell in x-major order.
+const HALF_NEIGHBOURS: [(i32, i32, i32); 13] = [
+    (-1, -1, -1),
+    (-1, -1, 0),
+    (-1, -1, 1),
+    (-1, 0, -1),
+    (-1, 0, 0),
+    (-1, 0, 1),
+    (-1, 1, -1),
+    (-1, 1, 0),
+    (-1, 1, 1),
+    (0, -1, -1),
+    (0, -1, 0),
+    (0, -1, 1),
+    (0, 0, -1),
+];
 
 /// Visits cell `c` of level `l` (>= 1): records its level over its level-1
 /// cells if the rule keeps it whole, else visits its children. Level-1

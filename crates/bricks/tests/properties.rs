@@ -1,7 +1,7 @@
 //! Property tests of conversion, lookups and the majorant walk against the
 //! reader's own tree (the independent reference).
 
-use cirrus_bricks::{convert_tree, BrickVolume, Precision, RaySegment, TIGHT_ENOUGH};
+use cirrus_bricks::{convert_tree, BrickVolume, Cell, Precision, RaySegment, TIGHT_ENOUGH};
 use cirrus_vdb::{Coord, Tree};
 use glam::{IVec3, Vec3};
 use proptest::prelude::*;
@@ -176,7 +176,7 @@ proptest! {
     }
 
     #[test]
-    fn partition_holds_the_cells_a_search_from_the_top_keeps(seed in 0u64..1000, split in prop::sample::select(vec![0.0f32, 0.5, 2.0, 8.0, 1e9])) {
+    fn partition_holds_the_cells_a_search_from_the_top_keeps_and_empty_distances(seed in 0u64..1000, split in prop::sample::select(vec![0.0f32, 0.5, 2.0, 8.0, 1e9])) {
         // The rule searched level by level from the coarsest cell down, for
         // every level-0 cell, against the table built once by recursion.
         let tree = random_tree(seed, IVec3::new(3, -40, 17));
@@ -185,6 +185,12 @@ proptest! {
         let top = vol.levels.len() - 1;
         let [dx, dy, dz] = vol.levels[0].dims;
         let mut kept_levels = [0usize; 10];
+        let mut far_empty = 0;
+        let d1 = vol.levels[1].dims;
+        let occupied: Vec<IVec3> = (0..d1[0] as i32)
+            .flat_map(|x| (0..d1[1] as i32).flat_map(move |y| (0..d1[2] as i32).map(move |z| IVec3::new(x, y, z))))
+            .filter(|c| vol.levels[1].get(c.to_array()).1 > 0.0)
+            .collect();
         for x in 0..dx as i32 {
             for y in 0..dy as i32 {
                 for z in 0..dz as i32 {
@@ -199,12 +205,28 @@ proptest! {
                         l -= 1;
                     }
                     kept_levels[l] += 1;
-                    prop_assert_eq!(cells.level_at(c0 >> 1), Some(l), "level-0 cell {:?}, split {}", c0, split);
+                    let c1 = IVec3::new(x >> 1, y >> 1, z >> 1);
+                    let expect = if vol.levels[1].get(c1.to_array()).1 > 0.0 {
+                        Cell::Kept(l)
+                    } else {
+                        // Chessboard distance to the nearest level-1 cell with density.
+                        let distance = occupied
+                            .iter()
+                            .map(|&o| (o - c1).abs().max_element() as u32)
+                            .min()
+                            .unwrap_or(127)
+                            .min(127);
+                        far_empty += usize::from(distance >= 2);
+                        Cell::Empty { distance }
+                    };
+                    prop_assert_eq!(cells.cell_at(c1), Some(expect), "level-0 cell {:?}, split {}", c0, split);
                 }
             }
         }
-        // The case is not trivial: some cells are kept below the top, and
+        // The case is not trivial: some empty cells are 2 or more cells from
+        // density, some cells are kept below the top, and
         // with an unbounded split only top cells are.
+        prop_assert!(far_empty > 0);
         let below_top: usize = kept_levels[..top].iter().sum();
         prop_assert_eq!(below_top == 0, split >= 1e9, "kept per level {:?}", kept_levels);
     }
