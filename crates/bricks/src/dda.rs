@@ -68,6 +68,8 @@ pub struct SegmentIter<'a> {
     pub steps: u32,
     /// Absolute part of the nudge: 1e-5 voxels along the ray's major axis.
     nudge_abs: f32,
+    /// Per axis, whether the ray leaves a cell through its upper face.
+    upward: glam::BVec3,
 }
 
 /// Slab test of a ray against the box [lo, hi]: the parameter interval inside.
@@ -110,6 +112,7 @@ impl<'a> SegmentIter<'a> {
             pending: None,
             steps: 0,
             nudge_abs: 1e-5 / dir.abs().max_element(),
+            upward: dir.cmpge(Vec3::ZERO),
         }
     }
 
@@ -143,7 +146,7 @@ impl<'a> SegmentIter<'a> {
                     let side = (1 << (CELL_LOG2 + 1)) as f32;
                     let lo = (c1 - r).as_vec3() * side;
                     let hi = (c1 + (r + 1)).as_vec3() * side;
-                    let far = Vec3::select(self.dir.cmpge(Vec3::ZERO), hi, lo);
+                    let far = Vec3::select(self.upward, hi, lo);
                     let exit = ((far - self.origin) * self.inv_dir).min_element();
                     self.t = exit.max(self.t + nudge).min(self.t_end);
                     continue;
@@ -162,8 +165,7 @@ impl<'a> SegmentIter<'a> {
                 size = 1.0;
                 cell_lo = voxel.as_vec3();
             }
-            let far =
-                cell_lo + Vec3::select(self.dir.cmpge(Vec3::ZERO), Vec3::splat(size), Vec3::ZERO);
+            let far = cell_lo + Vec3::select(self.upward, Vec3::splat(size), Vec3::ZERO);
             let exit = ((far - self.origin) * self.inv_dir).min_element();
             let t0 = self.t;
             let t1 = exit.max(t0 + nudge).min(self.t_end);

@@ -1,0 +1,48 @@
+//! `cirrus bench error` on a tiny scene: every configuration is measured at
+//! every budget, the files are written, and the report's arithmetic holds
+//! (the baseline against itself is exactly 1x; the ceiling is stated).
+
+use std::process::Command;
+
+#[test]
+fn error_bench_measures_every_configuration_and_reports_the_ceiling() {
+    let out_dir = std::env::temp_dir().join(format!("cirrus_bench_error_{}", std::process::id()));
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/sphere_fog.vdb");
+    let out = Command::new(env!("CARGO_BIN_EXE_cirrus"))
+        .args([
+            "bench",
+            "error",
+            data,
+            "--res",
+            "12x12",
+            "--budgets",
+            "0.02,0.04",
+        ])
+        .args(["--reference-time", "0.3", "--steps", "1", "--out"])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+
+    // 9 tracking configurations (3 estimators x 3 structures) and 2 ray
+    // marchers at one step, each at 2 budgets: 22 rows and a header.
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 22, "{csv}");
+    for row in &rows {
+        let rmse: f64 = row.split(',').nth(4).unwrap().parse().unwrap();
+        assert!(rmse.is_finite() && rmse >= 0.0, "{row}");
+    }
+    assert!(out_dir.join("error_vs_time.png").metadata().unwrap().len() > 1000);
+    assert!(out_dir.join("reference.exr").exists());
+
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    let baseline = report
+        .lines()
+        .find(|l| l.starts_with("| delta + ratio, global |"))
+        .unwrap_or_else(|| panic!("{report}"));
+    assert!(baseline.trim_end().ends_with("| 1.00x |"), "{baseline}");
+    assert!(report.contains("## The ceiling on this scene"), "{report}");
+    let _ = std::fs::remove_dir_all(&out_dir);
+}
