@@ -15,17 +15,17 @@
 //! level-1 cell holding density: every cell less than `d` away is empty,
 //! so the ray may jump to where it leaves that cube of `2d - 1` cells a side
 //! in one step, however the cube straddles the pyramid's aligned cells
-//! ("proximity clouds", Cohen and Sheffer 1994). Between the puffs of a
-//! cloudscape, or from a cloud's edge to its bounding box, that is a step or
-//! two where the aligned empty cells took tens.
+//! ("proximity clouds", Cohen and Sheffer 1994): one step crosses every
+//! aligned empty cell inside that cube, between the puffs of a cloudscape or
+//! from a cloud's edge to its bounding box.
 //!
 //! Layout: one `u8` per level-1 cell (8^3 voxels, one per brick): for a cell
 //! with density, the level of the kept cell that contains it, or 0 when its
 //! eight level-0 children are the kept cells; for an empty cell, `0x80 | d`.
 //! A table per level-0 cell would be eight times larger for no gain:
-//! level-0 cells need no decision. For the largest map the converter
-//! accepts (2^27 bricks) that is 128 MiB, as large as the brick map's refs /
-//! 4; for the corpus cloud it is 20 KiB.
+//! level-0 cells need no decision. That is a quarter of the brick map (a
+//! `u32` per brick): 128 MiB for the largest map the converter accepts
+//! (2^27 bricks), 20 KiB for the corpus cloud.
 
 use crate::bounds::{BoundsLevel, CELL_LOG2};
 use crate::dda::TIGHT_ENOUGH;
