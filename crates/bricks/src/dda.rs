@@ -5,8 +5,10 @@
 //! level down, read from a [`CellPartition`] made once for the rule
 //! (`partition.rs`), so a step is a table read and a slab exit whatever the
 //! depth. The rule:
-//! - an empty cell (max 0) is skipped whole, at the coarsest level that is
-//!   empty, so empty space costs a step per coarse cell;
+//! - an empty cell (max 0) is skipped whole; where a whole brick is empty
+//!   the walk jumps the largest empty cube of bricks around it (the
+//!   partition stores each empty brick's distance to density), so empty
+//!   space costs a step per cube;
 //! - a uniform cell (min == max: a tile, a constant region) is one segment
 //!   at whatever level it is uniform;
 //! - a cell whose minorant is at least half its majorant is one segment
