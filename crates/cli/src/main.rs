@@ -35,6 +35,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    quiet_when_stdout_closes();
     // The matches are kept so `render` can tell flags given on the command
     // line (which override a scene file) from defaults.
     let matches = <Cli as clap::CommandFactory>::command().get_matches();
@@ -60,4 +61,24 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `cirrus info FILE | head` closes stdout before cirrus is done with it:
+/// Rust ignores SIGPIPE, so the next `println!` panics with "failed
+/// printing to stdout: Broken pipe". The reader wanted no more output, so
+/// exit as a shell tool killed by SIGPIPE does (status 128 + 13) instead of
+/// printing a panic; every other panic keeps the default report.
+fn quiet_when_stdout_closes() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .unwrap_or_default();
+        if message.starts_with("failed printing to stdout") && message.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        default(info);
+    }));
 }

@@ -136,3 +136,23 @@ fn bad_input_is_a_clear_error_naming_the_file() {
     let (ok, _, stderr) = cirrus(&["info", "data/multi_grid.vdb", "--json", "--no-such-flag"]);
     assert!(!ok && stderr.contains("--no-such-flag"), "{stderr}");
 }
+
+#[test]
+fn a_reader_that_closes_stdout_early_gets_a_quiet_exit_not_a_panic() {
+    // The pipe's read end is closed before cirrus writes its first line,
+    // as `cirrus info FILE | head -0` would.
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_cirrus"))
+        .args(["info", "data/multi_grid.vdb"])
+        .current_dir(root())
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+        .wait_with_output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(141), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
