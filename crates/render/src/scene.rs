@@ -99,7 +99,7 @@ impl Default for RenderSettings {
     fn default() -> Self {
         Self {
             integrator: IntegratorKind::Path,
-            transmittance: TransmittanceEstimator::Ratio,
+            transmittance: TransmittanceEstimator::Residual,
             majorant: MajorantMode::Hierarchy,
             budget: Budget::Spp(16),
             seed: 0,

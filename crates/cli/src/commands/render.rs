@@ -161,7 +161,11 @@ pub struct SceneArgs {
     pub max_depth: Option<u32>,
     #[arg(long, default_value = "path", value_parser = ["path", "raymarch", "raymarch2pass"])]
     pub integrator: String,
-    #[arg(long, default_value = "ratio", value_parser = ["ratio", "residual", "track-length"])]
+    /// Shadow-ray transmittance estimator. Residual ratio tracking (the
+    /// segment minorants as control) is the default: in BENCHMARKS.md it is
+    /// 1.07x to 1.17x as efficient as plain ratio tracking over the
+    /// hierarchy, with less noise per path than track-length.
+    #[arg(long, default_value = "residual", value_parser = ["ratio", "residual", "track-length"])]
     pub transmittance: String,
     /// Majorants for tracking: the brick hierarchy, or one global majorant (Mitsuba-like).
     #[arg(long, default_value = "hierarchy", value_parser = ["hierarchy", "global"])]
