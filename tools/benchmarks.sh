@@ -34,13 +34,13 @@ $($cirrus bench traverse data/cloud.vdb)"
 
 section "Rendering: null collisions with the hierarchy and with one global majorant"
 for m in hierarchy global; do
-  $cirrus render data/cloud.vdb -o "$out/m_$m.exr" --res 256x256 --spp 16 "${cam[@]}" --majorant $m --stats "$out/m_$m.json" 2>/dev/null
+  $cirrus render data/cloud.vdb -o "$out/m_$m.exr" --res 256x256 --spp 16 "${cam[@]}" --majorant $m --transmittance ratio --stats "$out/m_$m.json" 2>/dev/null
 done
 code "$(python3 - "$out" <<'PY'
 import json, sys
 d = sys.argv[1]
 rows = {m: json.load(open(f"{d}/m_{m}.json")) for m in ("hierarchy", "global")}
-print("cirrus render data/cloud.vdb --res 256x256 --spp 16 (camera as above) --majorant hierarchy|global --stats")
+print("cirrus render data/cloud.vdb --res 256x256 --spp 16 (camera as above) --majorant hierarchy|global --transmittance ratio --stats")
 print(f"{'majorant':<10} {'paths/s':>10} {'null/real':>10} {'lookups/path':>13} {'shadow coll./ray':>17}")
 for m, s in rows.items():
     print(f"{m:<10} {s['rays_per_second']:>10.0f} {s['null_collisions']/s['real_collisions']:>10.3f} "
