@@ -63,6 +63,14 @@ $cirrus bench error data/cloud.vdb --res $res "${cam[@]}" --budgets $budgets --r
 cp "$out/error/error_vs_time.png" docs/benchmarks/error_vs_time.png
 sed 's#(error_vs_time.png)#(docs/benchmarks/error_vs_time.png)#; s/^# /### /; s/^## /### /' "$out/error/report.md" >> "$out/BENCHMARKS.md"
 
+section "Run time against error in single scattering, the ray marchers' own physics"
+# With multiple scattering the ray marchers (single scattering by design)
+# all flatten at the same error; against a single-scattering reference
+# what remains is their own bias (the two-pass light grid's, the step's).
+$cirrus bench error data/cloud.vdb --res $res "${cam[@]}" --max-depth 1 --budgets $budgets --reference-time $reftime --out "$out/error_single" > /dev/null 2>"$out/error_single.log"
+cp "$out/error_single/error_vs_time.png" docs/benchmarks/error_vs_time_single.png
+sed 's#(error_vs_time.png)#(docs/benchmarks/error_vs_time_single.png)#; s/^# /### /; s/^## /### /' "$out/error_single/report.md" >> "$out/BENCHMARKS.md"
+
 section "Run time against error on a sparse cloudscape"
 # Six puffs in one grid, seen from inside its bounding box: the case a
 # global majorant handles worst (tools/make_cloudscape.py, not committed).
