@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Regenerates BENCHMARKS.md: every figure in it comes from this script's run.
-#   bash tools/benchmarks.sh            # full run (about 25 minutes on 2 cores)
+#   bash tools/benchmarks.sh            # full run (about 35 minutes on 2 cores)
 #   QUICK=1 bash tools/benchmarks.sh    # short budgets, for a smoke test
 # Needs Debian's OpenVDB tools (vdb_print, vdb_render, python3-openvdb) and,
 # for the Mitsuba 3 comparison, what tools/mitsuba_setup.py installs.
