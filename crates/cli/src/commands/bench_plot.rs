@@ -63,6 +63,8 @@ pub fn error_vs_time(
                 .configure_mesh()
                 .x_desc("seconds")
                 .y_desc("RMSE")
+                .x_label_formatter(&tick)
+                .y_label_formatter(&tick)
                 .draw()?;
         } else {
             chart
@@ -93,6 +95,8 @@ pub fn error_vs_time(
         if text {
             chart
                 .configure_series_labels()
+                // Errors fall to the lower right: the lower left stays clear.
+                .position(SeriesLabelPosition::LowerLeft)
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 13))
@@ -102,4 +106,37 @@ pub fn error_vs_time(
     }
     std::fs::rename(&tmp, path)?;
     Ok(())
+}
+
+/// A tick label with three significant digits and no trailing zeros (a
+/// log axis's ticks are products like 0.009000000001 otherwise).
+fn tick(v: &f64) -> String {
+    if *v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn ticks_have_three_significant_digits_at_most() {
+        let cases = [
+            (0.009000000001, "0.009"),
+            (0.25, "0.25"),
+            (1.0, "1"),
+            (10.0, "10"),
+            (0.00123456, "0.00123"),
+            (2500.0, "2500"),
+        ];
+        for (v, want) in cases {
+            assert_eq!(super::tick(&v), want, "{v}");
+        }
+    }
 }
