@@ -84,11 +84,6 @@ impl CellPartition {
             Cell::Kept(code as usize)
         })
     }
-
-    /// Bytes of the table.
-    pub fn bytes(&self) -> usize {
-        self.levels.len()
-    }
 }
 
 impl BrickVolume {
@@ -116,8 +111,6 @@ impl BrickVolume {
                     }
                 }
             }
-        }
-        if top >= 1 {
             mark_empty_distances(&self.levels[1], &mut table);
         }
         CellPartition {
@@ -137,7 +130,7 @@ fn mark_empty_distances(level1: &BoundsLevel, table: &mut [u8]) {
     const CAP: u8 = 127;
     let [dx, dy, dz] = level1.dims.map(|d| d as i32);
     let at = |x: i32, y: i32, z: i32| ((x * dy + y) * dz + z) as usize;
-    let mut dist: Vec<u8> = (0..table.len()).map(|_| CAP).collect();
+    let mut dist = vec![CAP; table.len()];
     for x in 0..dx {
         for y in 0..dy {
             for z in 0..dz {

@@ -417,8 +417,7 @@ fn report(args: &ErrorArgs, rows: &[Row], w: u32, h: u32, collision_ns: f64) -> 
 /// run, their share `f` of the baseline's time bounds the speed-up by
 /// 1 / (1 - f).
 fn ceiling(s: &mut String, rows: &[Row], baseline: &str, collision_ns: f64) {
-    let last = |name: &str| rows.iter().rfind(|r| r.config == name);
-    let Some(base) = last(baseline) else {
+    let Some(base) = rows.iter().rfind(|r| r.config == baseline) else {
         return;
     };
     let threads = rayon::current_num_threads() as f64;
