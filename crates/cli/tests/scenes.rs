@@ -1,25 +1,11 @@
 //! Scene files, crops and merges, and what `--stats` shows a scene costs,
 //! through the `cirrus` binary.
 
+mod common;
+
+use common::{cirrus, root};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn cirrus(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cirrus"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 /// A scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -52,14 +38,14 @@ fn cropped_tiles_merge_bit_for_bit_into_the_full_render() {
         "albedo,depth,emission,direct,samples",
     ];
     let full = d.join("full.exr");
-    let (ok, err) = cirrus(&[&common[..], &["-o", s(&full)]].concat());
+    let (ok, _, err) = cirrus(&[&common[..], &["-o", s(&full)]].concat());
     assert!(ok, "{err}");
     // Three tiles of different shapes covering the image once.
     let crops = ["0,0,10,16", "10,0,24,9", "10,9,24,16"];
     let mut tiles = Vec::new();
     for (i, c) in crops.iter().enumerate() {
         let t = d.join(format!("tile{i}.exr"));
-        let (ok, err) = cirrus(&[&common[..], &["--crop", c, "-o", s(&t)]].concat());
+        let (ok, _, err) = cirrus(&[&common[..], &["--crop", c, "-o", s(&t)]].concat());
         assert!(ok, "{err}");
         let read = cirrus_render::exr_layers::read_channels(&t).unwrap();
         assert_eq!(read.full, (24, 16), "display window is the full image");
@@ -68,7 +54,7 @@ fn cropped_tiles_merge_bit_for_bit_into_the_full_render() {
     let merged = d.join("merged.exr");
     let mut args = vec!["merge", s(&merged)];
     args.extend(tiles.iter().map(|t| s(t)));
-    let (ok, err) = cirrus(&args);
+    let (ok, _, err) = cirrus(&args);
     assert!(ok, "{err}");
     let a = cirrus_render::exr_layers::read_channels(&full).unwrap();
     let b = cirrus_render::exr_layers::read_channels(&merged).unwrap();
@@ -93,7 +79,7 @@ fn cropped_tiles_merge_bit_for_bit_into_the_full_render() {
         assert!(same, "channel {na} differs");
     }
     // Overlapping tiles are refused.
-    let (ok, err) = cirrus(&["merge", s(&d.join("bad.exr")), s(&tiles[0]), s(&tiles[0])]);
+    let (ok, _, err) = cirrus(&["merge", s(&d.join("bad.exr")), s(&tiles[0]), s(&tiles[0])]);
     assert!(!ok && err.contains("two tiles"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -107,14 +93,14 @@ fn scene_file_errors_name_the_file_key_and_line() {
         "[camera]\nfov = 30\n\n[[volume]]\nfile = \"x.vdb\"\ndensty = \"d\"\n",
     )
     .unwrap();
-    let (ok, err) = cirrus(&["render", s(&scene), "-o", s(&d.join("o.exr"))]);
+    let (ok, _, err) = cirrus(&["render", s(&scene), "-o", s(&d.join("o.exr"))]);
     assert!(!ok);
     assert!(
         err.contains("bad.toml") && err.contains("line 6") && err.contains("densty"),
         "{err}"
     );
     std::fs::write(&scene, "[render]\nspp = -4\n").unwrap();
-    let (ok, err) = cirrus(&["render", s(&scene), "-o", s(&d.join("o.exr"))]);
+    let (ok, _, err) = cirrus(&["render", s(&scene), "-o", s(&d.join("o.exr"))]);
     assert!(
         !ok && err.contains("bad.toml") && err.contains("line 2"),
         "{err}"
@@ -156,7 +142,7 @@ transform = {{ translate = [5, 0, 0], euler = [0, 30, 0] }}
         ),
     )
     .unwrap();
-    let (ok, err) = cirrus(&["render", s(&scene), "--spp", "3"]);
+    let (ok, _, err) = cirrus(&["render", s(&scene), "--spp", "3"]);
     assert!(ok, "{err}");
     let st = stats(&d.join("two.json"));
     assert_eq!(st["spp"], 3, "the flag wins over the file");
@@ -216,12 +202,12 @@ transform = {{ translate = {far_translate} }}
     };
     // Behind the camera and off to the side: unreachable.
     write("[24, 0, 300]");
-    let (ok, err) = cirrus(&["render", s(&scene)]);
+    let (ok, _, err) = cirrus(&["render", s(&scene)]);
     assert!(ok, "{err}");
     assert_eq!(stats(&d.join("cull.json"))["grids_loaded"], 1, "{err}");
     // Straight above the visible sphere (toward the sun): it shadows it.
     write("[24, 200, 24]");
-    let (ok, err) = cirrus(&["render", s(&scene)]);
+    let (ok, _, err) = cirrus(&["render", s(&scene)]);
     assert!(ok, "{err}");
     assert_eq!(stats(&d.join("cull.json"))["grids_loaded"], 2, "{err}");
     let _ = std::fs::remove_dir_all(&d);
