@@ -148,15 +148,12 @@ impl<'a> SegmentIter<'a> {
                     let side = (1 << (CELL_LOG2 + 1)) as f32;
                     let lo = (c1 - r).as_vec3() * side;
                     let hi = (c1 + (r + 1)).as_vec3() * side;
-                    let far = Vec3::select(self.upward, hi, lo);
-                    let exit = ((far - self.origin) * self.inv_dir).min_element();
-                    self.t = exit.max(self.t + nudge).min(self.t_end);
+                    self.leave(lo, hi, nudge);
                     continue;
                 }
                 None => (0, (0.0, 0.0)),
             };
             let shift = (CELL_LOG2 + l as u32) as i32;
-            // Exit through the cell's far faces (the near ones are behind us).
             let mut size = (1i32 << shift) as f32;
             let mut cell_lo = (voxel >> shift).as_vec3() * size;
             if l == 0 && hi > lo && (hi - lo) * size > self.partition.voxel_split {
@@ -167,11 +164,8 @@ impl<'a> SegmentIter<'a> {
                 size = 1.0;
                 cell_lo = voxel.as_vec3();
             }
-            let far = cell_lo + Vec3::select(self.upward, Vec3::splat(size), Vec3::ZERO);
-            let exit = ((far - self.origin) * self.inv_dir).min_element();
-            let t0 = self.t;
-            let t1 = exit.max(t0 + nudge).min(self.t_end);
-            self.t = t1;
+            let t0 = self.leave(cell_lo, cell_lo + Vec3::splat(size), nudge);
+            let t1 = self.t;
             if hi > 0.0 {
                 return Some(RaySegment {
                     t0,
@@ -182,6 +176,19 @@ impl<'a> SegmentIter<'a> {
             }
         }
         None
+    }
+
+    /// Moves `t` to where the ray leaves the box `[lo, hi]` through its far
+    /// faces (the near ones are behind it), by at least `nudge` and at most
+    /// to the end of the ray; returns the `t` it left from. Every step ends
+    /// here, so every step makes progress (the module doc's guarantee).
+    #[inline]
+    fn leave(&mut self, lo: Vec3, hi: Vec3, nudge: f32) -> f32 {
+        let far = Vec3::select(self.upward, hi, lo);
+        let exit = ((far - self.origin) * self.inv_dir).min_element();
+        let t0 = self.t;
+        self.t = exit.max(t0 + nudge).min(self.t_end);
+        t0
     }
 }
 
