@@ -1,10 +1,10 @@
-//! The brick hierarchy on the corpus cloud: what issue 3 promises, measured.
+//! The brick hierarchy on the corpus cloud: the bounds it promises, measured.
 
-use cirrus::bricks::measure::{density_integral, measure, random_rays};
 use cirrus::bricks::{
     convert, read_cbrk, write_cbrk, FixedMajorantGrid, GlobalMajorant, Precision,
 };
 use cirrus::vdb::VolumeFile;
+use cirrus_bench::measure::{density_integral, measure, random_rays};
 use std::path::Path;
 
 fn cloud() -> cirrus::vdb::Grid {

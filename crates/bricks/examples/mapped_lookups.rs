@@ -7,7 +7,7 @@ fn main() {
         .nth(1)
         .expect("usage: mapped_lookups FILE.cbrk");
     let v = cirrus_bricks::read_cbrk(std::path::Path::new(&path)).unwrap();
-    let rays = cirrus_bricks::measure::random_rays(&v, 20000, 1);
+    let rays = cirrus_bench::measure::random_rays(&v, 20000, 1);
     let pts: Vec<glam::Vec3> = rays
         .iter()
         .flat_map(|r| (0..16).map(move |k| r.origin + r.dir * (r.t_max * (k as f32 + 0.5) / 16.0)))

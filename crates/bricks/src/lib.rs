@@ -19,7 +19,6 @@ mod convert;
 mod dda;
 mod format;
 mod layout;
-pub mod measure;
 mod partition;
 mod section;
 mod volume;

@@ -366,7 +366,7 @@ fn cbrk_round_trip_is_bit_identical_and_corruption_is_an_error() {
 
 #[test]
 fn baselines_bound_the_density_too_and_the_hierarchy_is_tighter() {
-    use cirrus_bricks::measure::{density_integral, measure, random_rays};
+    use cirrus_bench::measure::{density_integral, measure, random_rays};
     use cirrus_bricks::{FixedMajorantGrid, GlobalMajorant};
     let tree = random_tree(11, IVec3::ZERO);
     let vol = convert_tree(&tree, Precision::F32).unwrap();

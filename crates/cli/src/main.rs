@@ -1,7 +1,8 @@
 //! `cirrus`: the command-line front of the cirrus crates.
 //!
-//! Each subcommand lives in `commands/` and only parses, dispatches and
-//! prints; the work is in the library crates.
+//! Each subcommand in `commands/` maps its flags onto a library call and
+//! prints; scene loading, rendering and benchmarks live in `cirrus-scene`,
+//! `cirrus-render` and `cirrus-bench`.
 
 mod commands;
 
@@ -21,7 +22,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Print the grids of a .vdb or .nvdb file.
+    /// Print the grids of a .vdb, .nvdb or .cbrk file.
     Info(commands::info::InfoArgs),
     /// Convert a float grid into sparse bricks (.cbrk).
     Convert(commands::convert::ConvertArgs),
@@ -31,27 +32,16 @@ enum Command {
     Merge(commands::merge::MergeArgs),
     /// Benchmarks that print figures.
     #[command(subcommand)]
-    Bench(commands::bench::BenchCommand),
+    Bench(cirrus_bench::BenchCommand),
 }
 
 fn main() -> ExitCode {
     quiet_when_stdout_closes();
-    // The matches are kept so `render` can tell flags given on the command
-    // line (which override a scene file) from defaults.
-    let matches = <Cli as clap::CommandFactory>::command().get_matches();
-    let cli = match <Cli as clap::FromArgMatches>::from_arg_matches(&matches) {
-        Ok(cli) => cli,
-        Err(e) => e.exit(),
-    };
-    let sub = matches
-        .subcommand()
-        .map(|(_, m)| m.clone())
-        .unwrap_or_default();
-    let result = match cli.command {
+    let result = match Cli::parse().command {
         Command::Info(args) => commands::info::run(&args),
         Command::Convert(args) => commands::convert::run(&args),
-        Command::Bench(cmd) => commands::bench::run(&cmd),
-        Command::Render(args) => commands::render::run(&args, &sub),
+        Command::Bench(cmd) => cirrus_bench::run(&cmd),
+        Command::Render(args) => commands::render::run(&args),
         Command::Merge(args) => commands::merge::run(&args),
     };
     match result {

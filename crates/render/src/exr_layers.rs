@@ -19,7 +19,9 @@ use crate::film::AovImage;
 use crate::render::Rendered;
 
 /// The AOV layers a file can carry.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Aov {
     Albedo,
     Depth,
@@ -57,7 +59,7 @@ impl Aov {
     }
 
     /// Channel names and values of this layer over the window's pixels.
-    fn channels(self, a: &AovImage) -> Vec<(String, Vec<f32>)> {
+    pub fn channels(self, a: &AovImage) -> Vec<(String, Vec<f32>)> {
         let rgb = |layer: &str, v: &[[f32; 3]]| {
             ["R", "G", "B"]
                 .iter()
@@ -92,6 +94,11 @@ pub fn write_exr_layers(path: &Path, r: &Rendered, aovs: &[Aov]) -> std::io::Res
         return Err(std::io::Error::other(
             "AOVs were asked for but the render did not keep them",
         ));
+    }
+    if let Some(noisy) = &r.noisy {
+        for (c, n) in ["noisy.R", "noisy.G", "noisy.B"].iter().enumerate() {
+            channels.push((n.to_string(), noisy.iter().map(|p| p[c]).collect()));
+        }
     }
     let w = &r.window;
     write_channels(

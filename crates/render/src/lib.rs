@@ -34,6 +34,7 @@
 
 pub mod blackbody;
 pub mod camera;
+pub mod control;
 pub mod distribution;
 pub mod env_map;
 pub mod exr_layers;
@@ -53,6 +54,7 @@ pub mod volumes;
 
 pub use blackbody::Blackbody;
 pub use camera::Camera;
+pub use control::RenderControl;
 pub use env_map::EnvMap;
 pub use film::{AovImage, Image};
 pub use integrator::{
@@ -64,7 +66,7 @@ pub use medium::{
     ConstantBox, DensityField, GlobalMajorant, GlobalMedia, GridField, Interaction, MajorantGrid,
     MajorantSegment, Media, Medium,
 };
-pub use phase::HenyeyGreenstein;
+pub use phase::{HenyeyGreenstein, Phase};
 pub use ray::Ray;
 pub use render::{render, render_media, Rendered, Window};
 pub use sampling::Rng;

@@ -1,12 +1,14 @@
 //! The render loop: tiles over rayon, sample passes, time budget, progress.
 
 use std::io::IsTerminal;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
+use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Image};
 use crate::integrator::{
     CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
@@ -26,6 +28,9 @@ pub struct Rendered {
     pub window: Window,
     /// The AOV passes over the same pixels, if the settings asked for them.
     pub aovs: Option<AovImage>,
+    /// The image's RGB before a denoiser replaced it (written as the
+    /// `noisy.R/G/B` layer).
+    pub noisy: Option<Vec<[f32; 3]>>,
 }
 
 /// Placement of a rendered window in the full image (an EXR data window
@@ -77,11 +82,13 @@ fn render_with<M: Media>(
     let (image, aovs, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
             let s = PathTracer::new(medium, lights, settings.transmittance, settings.max_depth);
-            run(&s, camera, settings, start, &mut counters)
+            let (image, aovs) = run(&s, camera, settings, start, &mut counters);
+            (image, aovs, 0.0)
         }
         IntegratorKind::RayMarch => {
             let s = RayMarcher::new(medium, lights, settings.step_voxels);
-            run(&s, camera, settings, start, &mut counters)
+            let (image, aovs) = run(&s, camera, settings, start, &mut counters);
+            (image, aovs, 0.0)
         }
         IntegratorKind::RayMarch2Pass => {
             let grid = LightGrid::build(
@@ -94,7 +101,7 @@ fn render_with<M: Media>(
             );
             let setup = start.elapsed().as_secs_f64();
             let s = TwoPassMarcher::new(medium, lights, &grid, settings.step_voxels);
-            let (image, aovs, _) = run(&s, camera, settings, start, &mut counters);
+            let (image, aovs) = run(&s, camera, settings, start, &mut counters);
             (image, aovs, setup)
         }
     };
@@ -123,6 +130,7 @@ fn render_with<M: Media>(
             full_height: camera.height(),
         },
         aovs,
+        noisy: None,
     }
 }
 
@@ -149,14 +157,14 @@ fn crop_of(settings: &RenderSettings, camera: &Camera) -> Crop {
 }
 
 /// Runs sample passes until the budget is spent and resolves the film
-/// (and its AOVs); the third value is the setup time (none here).
+/// (and its AOVs).
 fn run<S: CameraSampler>(
     sampler: &S,
     camera: &Camera,
     settings: &RenderSettings,
     start: Instant,
     counters: &mut Counters,
-) -> (Image, Option<AovImage>, f64) {
+) -> (Image, Option<AovImage>) {
     let crop = crop_of(settings, camera);
     let mut film = Film::new(
         crop.x0,
@@ -185,7 +193,7 @@ fn run<S: CameraSampler>(
             let budget = Duration::from_secs_f64(seconds.max(0.0));
             let loop_start = Instant::now();
             let mut size = 1u32;
-            while size > 0 {
+            while size > 0 && !progress.cancelled() {
                 *counters += pass(
                     &mut film,
                     sampler,
@@ -209,7 +217,7 @@ fn run<S: CameraSampler>(
     }
     progress.finish();
     let image = film.resolve(spp, counters);
-    (image, film.resolve_aovs(), 0.0)
+    (image, film.resolve_aovs())
 }
 
 /// One pass: samples `s0..s1` for every pixel, tiles in parallel.
@@ -229,6 +237,9 @@ fn pass<S: CameraSampler>(
         .par_iter_mut()
         .map(|tile| {
             let mut c = Counters::default();
+            if progress.cancelled() {
+                return c;
+            }
             for ty in 0..tile.h {
                 for tx in 0..tile.w {
                     let (x, y) = (tile.x0 + tx, tile.y0 + ty);
@@ -252,19 +263,13 @@ fn pass<S: CameraSampler>(
 /// terminal or progress is off. Updated once per tile, never per sample.
 struct Progress {
     bar: Option<ProgressBar>,
+    control: Option<Arc<RenderControl>>,
     /// With a time budget the bar measures milliseconds, not samples.
     timed: Option<(Instant, u64)>,
 }
 
 impl Progress {
     fn new(settings: &RenderSettings, width: u32, height: u32) -> Self {
-        let off = Self {
-            bar: None,
-            timed: None,
-        };
-        if !settings.progress || !std::io::stderr().is_terminal() {
-            return off;
-        }
         let (len, timed) = match settings.budget {
             Budget::Spp(n) => {
                 let samples = u64::from(width) * u64::from(height) * u64::from(n.max(1));
@@ -275,6 +280,17 @@ impl Progress {
                 (ms, Some((Instant::now(), ms)))
             }
         };
+        let control = settings.control.clone();
+        if let Some(c) = &control {
+            c.start(len);
+        }
+        if !settings.progress || !std::io::stderr().is_terminal() {
+            return Self {
+                bar: None,
+                control,
+                timed,
+            };
+        }
         let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
         let style = ProgressStyle::with_template(
             "{spinner} [{elapsed_precise}] [{wide_bar}] {percent:>3}% ETA {eta} {msg}",
@@ -283,15 +299,27 @@ impl Progress {
         bar.set_style(style);
         Self {
             bar: Some(bar),
+            control,
             timed,
         }
     }
 
+    fn cancelled(&self) -> bool {
+        self.control.as_ref().is_some_and(|c| c.is_cancelled())
+    }
+
     fn tile_done(&self, samples: u64) {
+        let elapsed_ms = |(t0, ms): (Instant, u64)| (t0.elapsed().as_millis() as u64).min(ms);
+        if let Some(c) = &self.control {
+            match self.timed {
+                None => c.add(samples),
+                Some(t) => c.set(elapsed_ms(t)),
+            }
+        }
         let Some(bar) = &self.bar else { return };
         match self.timed {
             None => bar.inc(samples),
-            Some((t0, ms)) => bar.set_position((t0.elapsed().as_millis() as u64).min(ms)),
+            Some(t) => bar.set_position(elapsed_ms(t)),
         }
     }
 
@@ -302,6 +330,9 @@ impl Progress {
     }
 
     fn finish(&self) {
+        if let (Some(c), Some((_, ms))) = (&self.control, self.timed) {
+            c.set(ms);
+        }
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
         }

@@ -1,9 +1,12 @@
 //! What the caller fills in: the scene (medium, camera, lights) and the
 //! render settings.
 
-use serde::Serialize;
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
+use crate::control::RenderControl;
 use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::light::Lights;
 use crate::medium::Medium;
@@ -17,8 +20,9 @@ pub struct Scene<F> {
 }
 
 /// Which majorants the trackers use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum MajorantMode {
     /// The field's own local segments (its hierarchy or grid).
     #[default]
@@ -71,6 +75,8 @@ pub struct RenderSettings {
     pub crop: Option<Crop>,
     /// Keep the AOV passes (albedo, depth, emission, direct, samples).
     pub aovs: bool,
+    /// Progress and cancellation from another thread (bindings, servers).
+    pub control: Option<Arc<RenderControl>>,
 }
 
 /// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
@@ -110,6 +116,7 @@ impl Default for RenderSettings {
             progress: true,
             crop: None,
             aovs: false,
+            control: None,
         }
     }
 }

@@ -90,6 +90,13 @@ pub struct RenderStats {
     pub bytes_read: u64,
     /// Grids read from volume files (density, temperature, emission).
     pub grids_loaded: u64,
+    /// Volumes of a scene left unloaded: neither the camera nor any light
+    /// path can reach them.
+    pub volumes_culled: u64,
+    /// Wall time spent reading and converting volumes before rendering.
+    pub load_seconds: f64,
+    /// Wall time spent denoising after rendering (0 without `denoise`).
+    pub denoise_seconds: f64,
     /// Camera paths per second of wall time.
     pub rays_per_second: f64,
 }

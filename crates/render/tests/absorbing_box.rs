@@ -1,4 +1,4 @@
-//! (a) A purely absorbing constant box in a constant environment: every
+//! A purely absorbing constant box in a constant environment: every
 //! pixel is the environment attenuated by `exp(-sigma_t d)` along its chord.
 
 mod common;

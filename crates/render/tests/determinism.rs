@@ -1,4 +1,4 @@
-//! (e) The same seed gives a bit-identical image with 1 and 2 threads.
+//! The same seed gives a bit-identical image with 1 and 2 threads.
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! (c) The three shadow-ray estimators, and local versus global majorants,
+//! The three shadow-ray estimators, and local versus global majorants,
 //! estimate the same image.
 
 mod common;

@@ -1,4 +1,4 @@
-//! (b) White furnace: a non-absorbing medium in a constant environment,
+//! White furnace: a non-absorbing medium in a constant environment,
 //! without a sun, is invisible. Every pixel must equal the environment
 //! whatever the density, with unlimited scattering.
 

@@ -1,4 +1,4 @@
-//! (d) The ray marchers converge to the path tracer's single scattering
+//! The ray marchers converge to the path tracer's single scattering
 //! (`max_depth = 1`) as the step (and the two-pass light grid) shrink.
 
 mod common;

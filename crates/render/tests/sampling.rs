@@ -1,7 +1,8 @@
-//! The random number generator and the Henyey-Greenstein phase function.
+//! The random number generator and the Henyey-Greenstein phase function
+//! (`Phase::hg`; the other phase functions are in `phase_functions.rs`).
 
 use cirrus_render::light::Sun;
-use cirrus_render::HenyeyGreenstein;
+use cirrus_render::Phase;
 use cirrus_render::Rng;
 use glam::Vec3;
 
@@ -47,7 +48,7 @@ fn hg_sampled_mean_cosine_is_g() {
     let n = 100_000;
     let dir_in = Vec3::new(0.3, -0.5, 0.8).normalize();
     for g in GS {
-        let hg = HenyeyGreenstein::new(g);
+        let hg = Phase::hg(g);
         let mut rng = Rng::new(11, g.to_bits() as u64, 0);
         let (mut sum, mut sum2) = (0f64, 0f64);
         for _ in 0..n {
@@ -78,7 +79,7 @@ fn hg_pdf_integrates_to_one() {
     // (2e-4)^2 / 12; the skipped sliver [0, 1e-9] holds at most
     // 2 pi p_max 1e-9 < 1e-5; f32 evaluation adds ~1e-6. Tolerance 1e-4.
     for g in GS {
-        let hg = HenyeyGreenstein::new(g);
+        let hg = Phase::hg(g);
         let steps = 100_000;
         let (lo, hi) = (1e-9f64, 2.0f64);
         let r = (hi / lo).powf(1.0 / steps as f64);
@@ -97,8 +98,8 @@ fn hg_pdf_integrates_to_one() {
 #[test]
 fn hg_is_robust_at_the_extremes() {
     for g in [1.0, -1.0, f32::NAN, 1e-4, -1e-4] {
-        let hg = HenyeyGreenstein::new(g);
-        assert!(hg.g().abs() < 1.0);
+        let hg = Phase::hg(g);
+        assert!(hg.mean_cosine().abs() < 1.0);
         for mu in [-1.0, -0.5, 0.0, 0.999, 1.0] {
             let p = hg.eval_cos(mu);
             assert!(p.is_finite() && p > 0.0, "g = {g}, mu = {mu}: {p}");
@@ -109,7 +110,7 @@ fn hg_is_robust_at_the_extremes() {
         }
     }
     // Tiny g is snapped to isotropic so sample and eval agree exactly.
-    let hg = HenyeyGreenstein::new(1e-4);
+    let hg = Phase::hg(1e-4);
     assert_eq!(hg.eval_cos(0.3), 1.0 / (4.0 * std::f32::consts::PI));
 }
 

@@ -2,6 +2,7 @@
 
 use super::CliResult;
 use cirrus_bricks::{convert, write_cbrk, Precision};
+use cirrus_scene::grids::choose_grid;
 use cirrus_vdb::VolumeFile;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -19,42 +20,6 @@ pub struct ConvertArgs {
     /// The .cbrk file to write.
     #[arg(short, long)]
     pub output: PathBuf,
-}
-
-/// Picks the grid to render or convert: the one named, else "density",
-/// else the first float grid.
-pub fn choose_grid(
-    file: &VolumeFile,
-    name: Option<&str>,
-) -> Result<usize, Box<dyn std::error::Error>> {
-    if let Some(name) = name {
-        return Ok(file.find_grid(name)?);
-    }
-    let grids = file.grids();
-    grids
-        .iter()
-        .position(|g| g.name == "density" && g.value_type == Some(cirrus_vdb::ValueType::Float))
-        .or_else(|| {
-            grids
-                .iter()
-                .position(|g| g.value_type == Some(cirrus_vdb::ValueType::Float))
-        })
-        .ok_or_else(|| {
-            format!(
-                "{}: no float grid to use (grids: {})",
-                file.path().display(),
-                names(&grids)
-            )
-            .into()
-        })
-}
-
-fn names(grids: &[&cirrus_vdb::GridInfo]) -> String {
-    grids
-        .iter()
-        .map(|g| format!("{} ({})", g.name, g.type_name))
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 pub fn run(args: &ConvertArgs) -> CliResult {

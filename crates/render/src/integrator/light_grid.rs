@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::march::{marched_transmittance, MIN_STEP_VOXELS};
 use crate::light::Lights;
 use crate::medium::Media;
-use crate::phase::HenyeyGreenstein;
+use crate::phase::Phase;
 use crate::sampling::{from_local, Rng};
 use crate::stats::Counters;
 
@@ -40,10 +40,11 @@ impl Default for LightGridSettings {
 /// `T(p, w)`, as `a = mean of T` and `b = mean of T w` over the sphere.
 ///
 /// Kajiya and Von Herzen expanded the light field in spherical harmonics;
-/// bands 0 and 1 are enough here because HG's harmonic coefficients are
-/// `g^l` (Funk-Hecke), so the in-scattered environment light toward a ray
-/// travelling along `d` is `L_env * (a + 3 g b . d)`: exact for g = 0 and
-/// missing only the `g^2` and higher terms otherwise.
+/// bands 0 and 1 are enough here because by Funk-Hecke a phase function's
+/// band-1 coefficient is its mean cosine `<mu>` (`g` for HG, whose
+/// coefficients are `g^l`), so the in-scattered environment light toward a
+/// ray travelling along `d` is `L_env * (a + 3 <mu> b . d)`: exact for an
+/// isotropic phase function, missing only band 2 and higher otherwise.
 type Entry = [f32; 4 + 1];
 
 /// Sparse lattice of direct light over the field's bounds.
@@ -243,13 +244,7 @@ impl LightGrid {
     /// `dir` (pass two's in-scattering term).
     /// A map environment lights with its mean radiance here: the grid
     /// stores only the sky's transmittance (a biased baseline).
-    pub fn in_scatter(
-        &self,
-        phase: &HenyeyGreenstein,
-        lights: &Lights,
-        p: Vec3,
-        dir: Vec3,
-    ) -> Vec3 {
+    pub fn in_scatter(&self, phase: &Phase, lights: &Lights, p: Vec3, dir: Vec3) -> Vec3 {
         let e = self.lookup(p);
         let mut s = Vec3::ZERO;
         if let Some(sun) = &lights.sun {
@@ -258,7 +253,7 @@ impl LightGrid {
         }
         if let Some(env) = &lights.environment {
             let b = Vec3::new(e[2], e[3], e[4]);
-            let band = e[1] + 3.0 * phase.g() * b.dot(dir);
+            let band = e[1] + 3.0 * phase.mean_cosine() * b.dot(dir);
             s += env.mean_radiance() * band.max(0.0);
         }
         s

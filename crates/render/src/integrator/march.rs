@@ -14,7 +14,7 @@ use glam::Vec3;
 use super::{escaped_radiance, Sample};
 use crate::light::Lights;
 use crate::medium::Media;
-use crate::phase::HenyeyGreenstein;
+use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -111,7 +111,7 @@ pub(crate) fn march_camera_ray<M: Media>(
     h: f32,
     rng: &mut Rng,
     c: &mut Counters,
-    mut in_scatter: impl FnMut(Vec3, &HenyeyGreenstein, &mut Rng, &mut Counters) -> Vec3,
+    mut in_scatter: impl FnMut(Vec3, &Phase, &mut Rng, &mut Counters) -> Vec3,
 ) -> Sample {
     c.paths += 1;
     let emits = medium.emits();
@@ -125,7 +125,7 @@ pub(crate) fn march_camera_ray<M: Media>(
         let step_tr = (-sigma * h).exp();
         let p = ray.at(t);
         let it = medium.interaction(p, rng);
-        let mut source = it.albedo * in_scatter(p, &it.phase, rng, c);
+        let mut source = it.albedo * in_scatter(p, it.phase, rng, c);
         if emits {
             source += (Vec3::ONE - it.albedo) * medium.emission(p, it.instance, c);
         }

@@ -19,7 +19,7 @@ pub use raymarch::RayMarcher;
 pub use raymarch2pass::TwoPassMarcher;
 
 use glam::Vec3;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::light::Lights;
 use crate::ray::Ray;
@@ -27,12 +27,21 @@ use crate::sampling::{power_heuristic, Rng};
 use crate::stats::Counters;
 
 /// Which integrator renders the image.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum IntegratorKind {
+    /// Unbiased volumetric path tracing (delta tracking, NEE with MIS).
     #[default]
+    #[serde(rename = "path")]
+    #[cfg_attr(feature = "clap", value(name = "path"))]
     Path,
+    /// Single scattering by ray marching with jittered steps (biased preview).
+    #[serde(rename = "raymarch")]
+    #[cfg_attr(feature = "clap", value(name = "raymarch"))]
     RayMarch,
+    /// Two-pass ray marching over a cached light grid (Kajiya and Von Herzen).
+    #[serde(rename = "raymarch2pass")]
+    #[cfg_attr(feature = "clap", value(name = "raymarch2pass"))]
     RayMarch2Pass,
 }
 

@@ -5,7 +5,7 @@ use glam::Vec3;
 use super::{escaped_radiance, AovSample, CameraSampler, Sample};
 use crate::light::{LightSample, Lights};
 use crate::medium::Media;
-use crate::phase::HenyeyGreenstein;
+use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Rng};
 use crate::stats::Counters;
@@ -30,7 +30,7 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 /// - Next-event estimation at every scattering event: one sample of the
 ///   sun (if any) and one of the environment (if any), each shadow ray's
 ///   transmittance estimated by the chosen estimator. Directions from a
-///   light sampler and from HG sampling are combined with the power
+///   light sampler and from phase sampling are combined with the power
 ///   heuristic (Veach 1997); a delta sun gets NEE only. At the last
 ///   allowed scattering event NEE takes weight 1 and the path stops, since
 ///   the phase-sampled continuation could only reach lights at infinity;
@@ -77,7 +77,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         &self,
         p: Vec3,
         dir_in: Vec3,
-        phase: &HenyeyGreenstein,
+        phase: &Phase,
         mis: bool,
         rng: &mut Rng,
         c: &mut Counters,
@@ -105,7 +105,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         &self,
         p: Vec3,
         dir_in: Vec3,
-        phase: &HenyeyGreenstein,
+        phase: &Phase,
         s: LightSample,
         mis: bool,
         rng: &mut Rng,
@@ -115,7 +115,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         let weight = match s.pdf {
             None => f,
             Some(light_pdf) if light_pdf > 0.0 => {
-                // The phase function is sampled exactly: its pdf is f.
+                // Every phase function is sampled exactly: its pdf is f.
                 let w = if mis {
                     power_heuristic(light_pdf, f)
                 } else {
@@ -184,7 +184,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 break;
             }
             let last = self.max_depth == Some(depth);
-            let direct = beta * self.direct_light(p, ray.dir, &it.phase, !last, rng, c);
+            let direct = beta * self.direct_light(p, ray.dir, it.phase, !last, rng, c);
             l += direct;
             if depth == 1 {
                 aov.direct += direct;

@@ -7,7 +7,7 @@ use super::march::{march_camera_ray, marched_transmittance};
 use super::{CameraSampler, Sample};
 use crate::light::Lights;
 use crate::medium::Media;
-use crate::phase::HenyeyGreenstein;
+use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -17,7 +17,7 @@ use crate::stats::Counters;
 /// At every step the light arriving at the sample point is estimated with
 /// one marched shadow ray per light: toward the sun (a sun with an angular
 /// diameter is sampled uniformly over its disc) and, for the environment,
-/// along one HG-sampled direction (the phase-to-pdf ratio is then 1). It
+/// along one phase-sampled direction (the phase-to-pdf ratio is then 1). It
 /// converges to the path tracer with `max_depth = 1` as the step shrinks.
 /// Cost per camera ray grows with the square of the number of steps.
 pub struct RayMarcher<'a, M> {
@@ -43,7 +43,7 @@ impl<'a, M: Media> RayMarcher<'a, M> {
         &self,
         p: Vec3,
         dir: Vec3,
-        phase: &HenyeyGreenstein,
+        phase: &Phase,
         rng: &mut Rng,
         c: &mut Counters,
     ) -> Vec3 {

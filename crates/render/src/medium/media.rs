@@ -16,16 +16,20 @@ use glam::Vec3;
 
 use super::field::{DensityField, MajorantSegment};
 use super::Medium;
-use crate::phase::HenyeyGreenstein;
+use crate::phase::Phase;
 use crate::sampling::Rng;
 use crate::stats::Counters;
 
 /// What scatters (or emits) at a real collision.
+///
+/// The phase function is borrowed from the medium: a tabulated one lives
+/// behind an `Arc`, and cloning that per collision would put an atomic
+/// counter shared by every thread on the hot path.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Interaction {
+pub struct Interaction<'a> {
     /// `sigma_s / sigma_t` of the chosen instance, per RGB channel.
     pub albedo: Vec3,
-    pub phase: HenyeyGreenstein,
+    pub phase: &'a Phase,
     /// Index of the chosen instance (0 for a lone medium).
     pub instance: u32,
 }
@@ -57,7 +61,7 @@ pub trait Media: Send + Sync {
     /// probability `sigma_t,i(p) / sigma_t(p)`. Draws from `rng` only when
     /// several instances overlap at `p`, so a lone medium's random streams
     /// are those of the single-medium renderer.
-    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction;
+    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_>;
 
     /// Whether any instance emits; when false the integrators do no
     /// emission work at all.
@@ -131,10 +135,10 @@ impl<F: DensityField> Media for Medium<F> {
     }
 
     #[inline]
-    fn interaction(&self, _p: Vec3, _rng: &mut Rng) -> Interaction {
+    fn interaction(&self, _p: Vec3, _rng: &mut Rng) -> Interaction<'_> {
         Interaction {
             albedo: self.albedo,
-            phase: self.phase,
+            phase: &self.phase,
             instance: 0,
         }
     }
@@ -187,7 +191,7 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
     fn max_sigma_t(&self) -> f32 {
         self.majorant
     }
-    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction {
+    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
         self.inner.interaction(p, rng)
     }
     fn emits(&self) -> bool {

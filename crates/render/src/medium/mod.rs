@@ -27,10 +27,10 @@ pub use media::{GlobalMedia, Interaction, Media, Scaled};
 
 use glam::Vec3;
 
-use crate::phase::HenyeyGreenstein;
+use crate::phase::Phase;
 
 /// A grey participating medium: `sigma_t(p) = density_scale * density(p)`,
-/// `sigma_s = albedo * sigma_t` per colour channel, HG phase function.
+/// `sigma_s = albedo * sigma_t` per colour channel, and a phase function.
 ///
 /// Extinction is grey, so free-flight sampling and transmittance are scalar;
 /// a coloured albedo only tints the path throughput.
@@ -41,17 +41,23 @@ pub struct Medium<F> {
     pub density_scale: f32,
     /// Single-scattering albedo `sigma_s / sigma_t` per RGB channel, in [0, 1].
     pub albedo: Vec3,
-    pub phase: HenyeyGreenstein,
+    pub phase: Phase,
 }
 
 impl<F: DensityField> Medium<F> {
+    /// A medium with the Henyey-Greenstein phase function of asymmetry `g`
+    /// ([`Phase::hg`]); [`Medium::with_phase`] sets any other.
     pub fn new(field: F, density_scale: f32, albedo: Vec3, g: f32) -> Self {
         Self {
             field,
             density_scale,
             albedo,
-            phase: HenyeyGreenstein::new(g),
+            phase: Phase::hg(g),
         }
+    }
+
+    pub fn with_phase(self, phase: Phase) -> Self {
+        Self { phase, ..self }
     }
 
     /// Extinction coefficient at `p`.
@@ -66,7 +72,7 @@ impl<F: DensityField> Medium<F> {
             field: GlobalMajorant::new(&self.field),
             density_scale: self.density_scale,
             albedo: self.albedo,
-            phase: self.phase,
+            phase: self.phase.clone(),
         }
     }
 
@@ -77,7 +83,7 @@ impl<F: DensityField> Medium<F> {
             field: &self.field,
             density_scale: self.density_scale,
             albedo: self.albedo,
-            phase: self.phase,
+            phase: self.phase.clone(),
         }
     }
 }

@@ -4,7 +4,7 @@
 //! Each [`VolumeInstance`] is a density field already placed in render
 //! space (its object-to-world transform folded into the field, as
 //! [`BrickField`](crate::medium::BrickField) does), a density scale, an
-//! albedo, a Henyey-Greenstein `g`, and optional [`Emission`].
+//! albedo, a phase function, and optional [`Emission`].
 //!
 //! - `bvh`: the top-level BVH (obvhs) that finds the instances a ray meets.
 //! - `merge`: where instances overlap, extinction and the majorant (and
@@ -24,7 +24,7 @@ use glam::Vec3;
 
 use crate::blackbody::Blackbody;
 use crate::medium::{DensityField, Interaction, MajorantSegment, Media, Scaled};
-use crate::phase::HenyeyGreenstein;
+use crate::phase::Phase;
 use crate::sampling::Rng;
 use crate::stats::Counters;
 
@@ -68,19 +68,25 @@ pub struct VolumeInstance<F> {
     /// Extinction per unit density, in 1 / render-space units.
     pub density_scale: f32,
     pub albedo: Vec3,
-    pub phase: HenyeyGreenstein,
+    pub phase: Phase,
     pub emission: Option<Emission<F>>,
 }
 
 impl<F: DensityField> VolumeInstance<F> {
+    /// An instance with the Henyey-Greenstein phase function of asymmetry
+    /// `g` ([`Phase::hg`]); [`VolumeInstance::with_phase`] sets any other.
     pub fn new(density: F, density_scale: f32, albedo: Vec3, g: f32) -> Self {
         Self {
             density,
             density_scale,
             albedo,
-            phase: HenyeyGreenstein::new(g),
+            phase: Phase::hg(g),
             emission: None,
         }
+    }
+
+    pub fn with_phase(self, phase: Phase) -> Self {
+        Self { phase, ..self }
     }
 
     #[inline]
@@ -88,10 +94,10 @@ impl<F: DensityField> VolumeInstance<F> {
         self.density_scale * self.density.density(p)
     }
 
-    fn interaction(&self, instance: usize) -> Interaction {
+    fn interaction(&self, instance: usize) -> Interaction<'_> {
         Interaction {
             albedo: self.albedo,
-            phase: self.phase,
+            phase: &self.phase,
             instance: instance as u32,
         }
     }
@@ -228,7 +234,7 @@ impl<F: DensityField> Media for Volumes<F> {
     /// One instance: its material, no random number. Several: each
     /// instance containing `p` with probability `sigma_t,i / sigma_t`; a
     /// random number is drawn only when two or more have density there.
-    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction {
+    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
         if self.instances.len() == 1 {
             return self.instances[0].interaction(0);
         }

@@ -9,20 +9,20 @@
 //! 1 / (MSE x time), reported relative to the Mitsuba-like baseline (delta
 //! tracking + ratio tracking over one global majorant) at the same budget.
 
-use super::render::{prepare, SceneArgs};
-use super::CliResult;
+use crate::BenchResult;
 use cirrus_render::medium::BrickField;
 use cirrus_render::{
     render, Budget, IntegratorKind, MajorantMode, Medium, RenderSettings, Scene,
     TransmittanceEstimator,
 };
+use cirrus_scene::{Scene as SceneFile, SceneFlags};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct ErrorArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
+    pub scene: SceneFlags,
     /// Output folder: results.csv, error_vs_time.png, report.md, reference.exr.
     #[arg(long)]
     pub out: PathBuf,
@@ -151,13 +151,15 @@ fn read_exr_rgba(path: &Path) -> Result<RgbaImage, Box<dyn std::error::Error>> {
     ))
 }
 
-pub fn run(args: &ErrorArgs) -> CliResult {
+pub fn run(args: &ErrorArgs) -> BenchResult {
     std::fs::create_dir_all(&args.out)?;
-    let volume = super::render::load_volume(&args.scene.file, args.scene.grid.as_deref())?;
-    let (scene, base) = prepare(&args.scene, &volume)?;
-    let (w, h) = args.scene.res;
+    let mut file = SceneFile::load(&args.scene.file)?;
+    file.apply(&args.scene.overrides());
+    let lone = file.lone()?;
+    let (scene, base) = lone.prepare()?;
+    let (w, h) = lone.settings.res;
     let fixed_scene = {
-        let (s, _) = prepare(&args.scene, &volume)?;
+        let (s, _) = lone.prepare()?;
         let Scene {
             medium,
             camera,
@@ -265,10 +267,10 @@ pub fn run(args: &ErrorArgs) -> CliResult {
         }
     }
     write_csv(&args.out.join("results.csv"), &rows)?;
-    super::bench_plot::error_vs_time(&args.out.join("error_vs_time.png"), &rows_for_plot(&rows))?;
+    crate::plot::error_vs_time(&args.out.join("error_vs_time.png"), &rows_for_plot(&rows))?;
     let collision_ns = collision_cost_ns(&scene.medium);
     let report = report(args, &rows, w, h, collision_ns);
-    super::write_whole(&args.out.join("report.md"), report.as_bytes())?;
+    crate::write_whole(&args.out.join("report.md"), report.as_bytes())?;
     println!("{report}");
     Ok(())
 }
@@ -341,7 +343,7 @@ fn write_csv(path: &Path, rows: &[Row]) -> std::io::Result<()> {
             r.null_per_real
         );
     }
-    super::write_whole(path, s.as_bytes())
+    crate::write_whole(path, s.as_bytes())
 }
 
 /// The markdown report: one row per configuration with its error at the

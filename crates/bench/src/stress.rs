@@ -18,7 +18,7 @@
 //! Density policy under test: NaN, infinite and negative voxels are stored
 //! as 0 and counted (`SourceInfo::sanitized_voxels`).
 
-use super::CliResult;
+use crate::BenchResult;
 use cirrus_bricks::{convert, BrickVolume, Precision};
 use cirrus_render::medium::BrickField;
 use cirrus_render::{
@@ -335,7 +335,7 @@ fn run_case(case: &Case) -> Result<(CaseResult, RenderStats), Box<dyn std::error
     ))
 }
 
-pub fn run(args: &StressArgs) -> CliResult {
+pub fn run(args: &StressArgs) -> BenchResult {
     let mut results = Vec::new();
     for case in cases() {
         let start = std::time::Instant::now();

@@ -1,19 +1,25 @@
-//! The scene file of `cirrus render SCENE.toml`: its schema and parser.
+//! The scene description: exactly the TOML format of a scene file (and the
+//! JSON form the Python bindings pass for a dict).
 //!
 //! Every table and field maps to a `cirrus render` flag (the README's
-//! "Scene files" section has the table); flags given on the command line
-//! override the file. Unknown keys and wrong types are errors that name
-//! the file, the key, and its line and column (serde's
-//! `deny_unknown_fields`; toml's errors carry the span).
+//! "Scene files" section has the table); [`Overrides`](crate::Overrides)
+//! written over it win. Every field is optional here; the defaults are
+//! applied when the description is resolved (`defaults.rs`). Unknown keys
+//! and wrong types are errors that name the file, the key, and its line
+//! and column (serde's `deny_unknown_fields`; toml's errors carry the span).
 
 use std::path::{Path, PathBuf};
 
+use cirrus_render::exr_layers::Aov;
+use cirrus_render::{IntegratorKind, MajorantMode, TransmittanceEstimator};
 use serde::Deserialize;
 
+use crate::error::{Error, Result};
+
 /// A whole scene file.
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SceneFile {
+pub struct SceneDescription {
     #[serde(default)]
     pub output: OutputSpec,
     #[serde(default)]
@@ -29,58 +35,40 @@ pub struct SceneFile {
 }
 
 /// `-o`, `--png`, `--exposure`, `--stats`, `--aov`, `--crop`.
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     pub exr: Option<PathBuf>,
     pub png: Option<PathBuf>,
     pub exposure: Option<f32>,
     pub stats: Option<PathBuf>,
-    pub aov: Option<Vec<String>>,
+    pub aov: Option<Vec<Aov>>,
     /// `[x0, y0, x1, y1]`, pixels, half-open.
     pub crop: Option<[u32; 4]>,
 }
 
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum IntegratorName {
-    Path,
-    Raymarch,
-    Raymarch2pass,
-}
-
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum TransmittanceName {
-    Ratio,
-    Residual,
-    TrackLength,
-}
-
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum MajorantName {
-    Hierarchy,
-    Global,
-}
-
 /// `--spp`, `--time`, `--seed`, `--integrator`, `--transmittance`,
-/// `--majorant`, `--max-depth`, `--step`.
-#[derive(Debug, Default, Deserialize)]
+/// `--majorant`, `--max-depth`, `--step`, `--refine-optical-depth`.
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RenderSpec {
     pub spp: Option<u32>,
     pub time: Option<f64>,
     pub seed: Option<u64>,
-    pub integrator: Option<IntegratorName>,
-    pub transmittance: Option<TransmittanceName>,
-    pub majorant: Option<MajorantName>,
+    pub integrator: Option<IntegratorKind>,
+    pub transmittance: Option<TransmittanceEstimator>,
+    pub majorant: Option<MajorantMode>,
     pub max_depth: Option<u32>,
     pub step: Option<f32>,
+    /// Majorant cells are refined while crossing one costs more than this
+    /// optical depth in null collisions (lone volumes).
+    pub refine_optical_depth: Option<f32>,
+    /// Denoise the image with Open Image Denoise, guided by the albedo AOV.
+    pub denoise: Option<bool>,
 }
 
 /// `--res`, `--camera-from`, `--camera-to`, `--camera-up`, `--fov`.
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
     /// `"WxH"`, as the flag.
@@ -93,7 +81,7 @@ pub struct CameraSpec {
 }
 
 /// `--sun-dir`, `--sun-irradiance`, `--sun-angle`, `--no-sun`.
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SunSpec {
     pub enabled: Option<bool>,
@@ -105,7 +93,7 @@ pub struct SunSpec {
 }
 
 /// `--env-radiance`, `--env-map`, `--env-rotation`, `--env-intensity`.
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentSpec {
     /// Constant radiance (ignored when a map is given).
@@ -136,7 +124,7 @@ impl Colour {
 
 /// One volume instance. `--grid`, `--density-scale`, `--albedo` and `--g`
 /// given on the command line apply to every volume.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VolumeSpec {
     /// A .vdb, .nvdb or .cbrk file, relative to the scene file.
@@ -159,7 +147,7 @@ pub struct VolumeSpec {
 }
 
 /// Object to world: scale, then rotate, then translate.
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TransformSpec {
     pub translate: Option<[f64; 3]>,
@@ -172,7 +160,7 @@ pub struct TransformSpec {
     pub scale: Option<ScaleSpec>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AxisAngle {
     pub axis: [f64; 3],
@@ -187,7 +175,7 @@ pub enum ScaleSpec {
 }
 
 /// pbrt-v4's blackbody parameters: `Le = scale * Blackbody((T - offset) * temperature_scale)`.
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BlackbodySpec {
     pub scale: Option<f32>,
@@ -195,24 +183,52 @@ pub struct BlackbodySpec {
     pub temperature_scale: Option<f32>,
 }
 
-fn resolution<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(u32, u32)>, D::Error> {
+fn resolution<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<Option<(u32, u32)>, D::Error> {
     let s = String::deserialize(d)?;
-    super::render::resolution(&s)
+    crate::parse::resolution(&s)
         .map(Some)
         .map_err(serde::de::Error::custom)
 }
 
-impl SceneFile {
+impl SceneDescription {
     /// Reads and parses `path`; errors name the file (toml's messages give
     /// the line, column and key).
-    pub fn read(path: &Path) -> Result<SceneFile, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        Self::parse(&text).map_err(|e| format!("{}: {e}", path.display()))
+    pub fn read(path: &Path) -> Result<SceneDescription> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::file(format!("{}: {e}", path.display())))?;
+        Self::parse(&text).map_err(|e| Error::input(format!("{}: {e}", path.display())))
     }
 
-    pub fn parse(text: &str) -> Result<SceneFile, String> {
-        let file: SceneFile = toml::from_str(text).map_err(|e| e.to_string())?;
-        for (i, v) in file.volumes.iter().enumerate() {
+    /// Parses the TOML form.
+    pub fn parse(text: &str) -> std::result::Result<SceneDescription, String> {
+        let file: SceneDescription = toml::from_str(text).map_err(|e| e.to_string())?;
+        file.check()?;
+        Ok(file)
+    }
+
+    /// Parses the JSON form (the same fields and nesting as the TOML).
+    pub fn from_json(text: &str) -> std::result::Result<SceneDescription, String> {
+        let file: SceneDescription = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        file.check()?;
+        Ok(file)
+    }
+
+    /// Input paths (volumes, sky map) relative to `dir`, as a scene file's
+    /// are relative to the file.
+    pub fn rebase(&mut self, dir: &Path) {
+        for v in &mut self.volumes {
+            v.file = dir.join(&v.file);
+        }
+        if let Some(map) = self.environment.as_mut().and_then(|e| e.map.as_mut()) {
+            *map = dir.join(&*map);
+        }
+    }
+
+    /// What serde cannot say: exclusive fields.
+    fn check(&self) -> std::result::Result<(), String> {
+        for (i, v) in self.volumes.iter().enumerate() {
             if v.transform.rotate.is_some() && v.transform.euler.is_some() {
                 return Err(format!(
                     "volume {} ({}): give `rotate` or `euler`, not both",
@@ -221,7 +237,7 @@ impl SceneFile {
                 ));
             }
         }
-        Ok(file)
+        Ok(())
     }
 }
 
@@ -231,19 +247,20 @@ mod tests {
 
     #[test]
     fn unknown_keys_and_wrong_types_name_the_key_and_line() {
-        let e = SceneFile::parse("[camera]\nfov = 30\nfocal = 2\n").unwrap_err();
+        let e = SceneDescription::parse("[camera]\nfov = 30\nfocal = 2\n").unwrap_err();
         assert!(e.contains("line 3") && e.contains("focal"), "{e}");
-        let e = SceneFile::parse("[render]\nspp = \"many\"\n").unwrap_err();
+        let e = SceneDescription::parse("[render]\nspp = \"many\"\n").unwrap_err();
         assert!(e.contains("line 2") && e.contains("spp"), "{e}");
-        let e = SceneFile::parse("[[volume]]\nfile = \"a.vdb\"\nalbedo = [1, 2]\n").unwrap_err();
+        let e =
+            SceneDescription::parse("[[volume]]\nfile = \"a.vdb\"\nalbedo = [1, 2]\n").unwrap_err();
         assert!(e.contains("line 3") && e.contains("albedo"), "{e}");
-        let e = SceneFile::parse("[camera]\nres = \"12by4\"\n").unwrap_err();
+        let e = SceneDescription::parse("[camera]\nres = \"12by4\"\n").unwrap_err();
         assert!(e.contains("line 2") && e.contains("WxH"), "{e}");
     }
 
     #[test]
     fn a_full_scene_parses() {
-        let s = SceneFile::parse(
+        let s = SceneDescription::parse(
             r#"
             [output]
             exr = "a.exr"
@@ -275,7 +292,10 @@ mod tests {
         .unwrap();
         assert_eq!(s.volumes.len(), 2);
         assert_eq!(s.camera.res, Some((32, 16)));
-        assert_eq!(s.render.transmittance, Some(TransmittanceName::TrackLength));
+        assert_eq!(
+            s.render.transmittance,
+            Some(TransmittanceEstimator::TrackLength)
+        );
         assert_eq!(s.volumes[0].albedo.unwrap().rgb(), [0.9, 0.8, 0.7]);
         assert_eq!(s.volumes[1].blackbody.temperature_scale, Some(1000.0));
     }

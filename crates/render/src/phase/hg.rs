@@ -1,16 +1,9 @@
-//! The Henyey-Greenstein phase function.
-//!
-//! Convention: both directions are *propagation* directions along the path
-//! from the camera, so `mu = dot(dir_in, dir_out)` is the cosine of the
-//! scattering angle and `g > 0` scatters forward (`dir_out` near `dir_in`).
-//! For next-event estimation `dir_out` is the direction toward the light,
-//! which by reciprocity gives the same `mu` as the light's own path.
+//! The Henyey-Greenstein lobe: the default phase function and a building
+//! block of the two-lobe and approximate-Mie blends.
 
 use std::f32::consts::PI;
 
-use glam::Vec3;
-
-use crate::sampling::from_local;
+use super::Lobe;
 
 /// Below this |g| the function is taken as isotropic: the inversion formula
 /// divides by g and cancels badly (pbrt-v4 uses the same cut-off). `new`
@@ -60,15 +53,8 @@ impl HenyeyGreenstein {
         (1.0 - g) * (1.0 + g) / (4.0 * PI * denom * denom.sqrt())
     }
 
-    /// Density of scattering from propagation direction `dir_in` into
-    /// `dir_out` (both unit vectors).
-    #[inline]
-    pub fn eval(&self, dir_in: Vec3, dir_out: Vec3) -> f32 {
-        self.eval_cos(dir_in.dot(dir_out))
-    }
-
     /// Inverts the HG CDF in `mu` (e.g. pbrt-v4 `SampleHenyeyGreenstein`,
-    /// written for this file's sign convention).
+    /// written for this module's sign convention).
     #[inline]
     pub fn sample_cos(&self, u: f32) -> f32 {
         let g = self.g;
@@ -78,16 +64,20 @@ impl HenyeyGreenstein {
         let s = (1.0 - g) * (1.0 + g) / (1.0 - g + 2.0 * g * u);
         ((1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)
     }
+}
 
-    /// Samples an outgoing propagation direction; returns it and its pdf,
-    /// which equals the phase value (sampling is exact, so the path weight
-    /// `p / pdf` is 1).
+impl Lobe for HenyeyGreenstein {
     #[inline]
-    pub fn sample(&self, dir_in: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
-        let mu = self.sample_cos(u1);
-        let sin = (1.0 - mu * mu).max(0.0).sqrt();
-        let phi = 2.0 * PI * u2;
-        let dir = from_local(dir_in, sin * phi.cos(), sin * phi.sin(), mu);
-        (dir, self.eval_cos(mu))
+    fn eval_cos(&self, mu: f32) -> f32 {
+        HenyeyGreenstein::eval_cos(self, mu)
+    }
+
+    #[inline]
+    fn sample_cos(&self, u: f32) -> f32 {
+        HenyeyGreenstein::sample_cos(self, u)
+    }
+
+    fn mean_cosine(&self) -> f32 {
+        self.g
     }
 }

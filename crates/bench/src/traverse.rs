@@ -1,25 +1,12 @@
 //! `cirrus bench traverse FILE`: majorant structures side by side on the
 //! same random rays, plus conversion speed and memory.
 
-use super::CliResult;
-use cirrus_bricks::measure::{density_integral, measure, random_rays, TraversalReport};
+use crate::measure::{density_integral, measure, random_rays, TraversalReport};
+use crate::BenchResult;
 use cirrus_bricks::{convert, FixedMajorantGrid, GlobalMajorant, Precision};
 use cirrus_vdb::VolumeFile;
 use std::path::PathBuf;
 use std::time::Instant;
-
-#[derive(clap::Subcommand)]
-pub enum BenchCommand {
-    /// Segments per ray, rays/s, lookups/s and bound tightness for a global
-    /// majorant, a fixed pbrt-style grid and cirrus's hierarchy.
-    Traverse(TraverseArgs),
-    /// Run time against error for every estimator and majorant structure,
-    /// with a converged reference: results.csv, error_vs_time.png, report.md.
-    Error(Box<super::bench_error::ErrorArgs>),
-    /// Numerical stress: extreme scales, sizes, positions, grazing rays,
-    /// cameras inside volumes, bad voxels, underflowing optical depths.
-    Stress(super::bench_stress::StressArgs),
-}
 
 #[derive(clap::Args)]
 pub struct TraverseArgs {
@@ -39,17 +26,9 @@ pub struct TraverseArgs {
     pub nvdb: Option<PathBuf>,
 }
 
-pub fn run(cmd: &BenchCommand) -> CliResult {
-    match cmd {
-        BenchCommand::Traverse(args) => traverse(args),
-        BenchCommand::Error(args) => super::bench_error::run(args),
-        BenchCommand::Stress(args) => super::bench_stress::run(args),
-    }
-}
-
-fn traverse(args: &TraverseArgs) -> CliResult {
+pub fn run(args: &TraverseArgs) -> BenchResult {
     let file = VolumeFile::open(&args.file)?;
-    let index = super::convert::choose_grid(&file, args.grid.as_deref())?;
+    let index = cirrus_scene::grids::choose_grid(&file, args.grid.as_deref())?;
     let start = Instant::now();
     let grid = file.read_grid(index)?;
     let load_s = start.elapsed().as_secs_f64();

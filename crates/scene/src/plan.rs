@@ -1,19 +1,21 @@
-//! Loading the volumes of a scene file: each volume's plan (file, grids,
+//! Loading the volumes of a scene: each volume's plan (file, grids,
 //! transform, medium, world box) and the files and grids read for it,
 //! each read once however many instances use it, with the bytes it cost.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use cirrus_bricks::{convert, read_cbrk, BrickVolume, Precision};
+use cirrus_bricks::BrickVolume;
 use cirrus_render::medium::BrickField;
 use cirrus_render::{Blackbody, DensityField, VolumeInstance};
 use cirrus_vdb::VolumeFile;
 use glam::{DMat4, DVec3, Vec3};
 
-use super::render::SceneArgs;
-use super::scene_cull::WorldBox;
-use super::scene_file::{ScaleSpec, VolumeSpec};
+use crate::cull::WorldBox;
+use crate::defaults as d;
+use crate::description::{ScaleSpec, VolumeSpec};
+use crate::error::{Error, Result};
+use crate::grids::{choose_grid, is_cbrk, read_bricks, read_cbrk_file};
 
 /// One volume's plan: where its grids are and how it is placed.
 pub struct Plan {
@@ -61,44 +63,37 @@ fn object_to_world(v: &VolumeSpec) -> DMat4 {
     translate * rotate * DMat4::from_scale(scale)
 }
 
-pub fn plan(
-    v: &VolumeSpec,
-    dir: &Path,
-    scene: &SceneArgs,
-    given: &dyn Fn(&str) -> bool,
-    files: &mut Files,
-) -> Result<Plan, String> {
-    let path = dir.join(&v.file);
+/// The plan of volume `v` (its file already relative to the working
+/// directory); opens its file, reading the index only.
+pub fn plan(v: &VolumeSpec, files: &mut Files) -> Result<Plan> {
+    let path = v.file.clone();
     let object_to_world = object_to_world(v);
     if !object_to_world.is_finite() || object_to_world.determinant().abs() < 1e-300 {
-        return Err(format!("{}: the transform is singular", v.file.display()));
+        return Err(Error::input(format!(
+            "{}: the transform is singular",
+            v.file.display()
+        )));
     }
-    let density_name = if given("grid") {
-        scene.grid.clone()
-    } else {
-        v.density.clone().or(scene.grid.clone())
-    };
-    let cbrk = path.extension().is_some_and(|e| e == "cbrk");
+    let cbrk = is_cbrk(&path);
     let (density, temperature, emission, world_box) = if cbrk {
         if v.temperature.is_some() || v.emission.is_some() {
-            return Err(format!(
+            return Err(Error::input(format!(
                 "{}: a .cbrk holds one density grid; temperature and emission need the .vdb",
                 path.display()
-            ));
+            )));
         }
         (0, None, None, None)
     } else {
         let f = files.open(&path)?;
-        let err = |e: Box<dyn std::error::Error>| e.to_string();
-        let density = super::convert::choose_grid(f, density_name.as_deref()).map_err(err)?;
-        let named = |n: &Option<String>| -> Result<Option<usize>, String> {
+        let density = choose_grid(f, v.density.as_deref())?;
+        let named = |n: &Option<String>| -> Result<Option<usize>> {
             n.as_ref()
-                .map(|n| f.find_grid(n).map_err(|e| e.to_string()))
+                .map(|n| f.find_grid(n).map_err(|e| Error::input(e.to_string())))
                 .transpose()
         };
         let temperature = named(&v.temperature)?;
         let emission = named(&v.emission)?;
-        let header = f.grid_bounds(density).map_err(|e| e.to_string())?;
+        let header = f.grid_bounds(density)?;
         let world_box = header.map(|(t, lo, hi)| {
             // Trilinear support reaches one voxel past the active box.
             let lo = DVec3::from_array(lo.map(f64::from)) - 1.0;
@@ -116,19 +111,11 @@ pub fn plan(
         emission,
         object_to_world,
         world_box,
-        density_scale: if given("density_scale") {
-            scene.density_scale
-        } else {
-            v.density_scale.or(scene.density_scale)
-        },
-        albedo: match (v.albedo, given("albedo")) {
-            (Some(a), false) => Vec3::from_array(a.rgb()),
-            _ => Vec3::splat(scene.albedo),
-        },
-        g: match (v.g, given("g")) {
-            (Some(g), false) => g,
-            _ => scene.g,
-        },
+        density_scale: v.density_scale,
+        albedo: v
+            .albedo
+            .map_or(Vec3::splat(d::ALBEDO), |a| Vec3::from_array(a.rgb())),
+        g: v.g.unwrap_or(d::G),
         blackbody: Blackbody {
             scale: bb.scale.unwrap_or(1.0),
             offset: bb.offset.unwrap_or(0.0),
@@ -164,25 +151,23 @@ pub struct Files {
 }
 
 impl Files {
-    fn open(&mut self, path: &Path) -> Result<&VolumeFile, String> {
+    fn open(&mut self, path: &Path) -> Result<&VolumeFile> {
         if !self.open.contains_key(path) {
-            let f = VolumeFile::open(path).map_err(|e| e.to_string())?;
+            let f = VolumeFile::open(path)?;
             self.open.insert(path.to_path_buf(), f);
         }
         Ok(&self.open[path])
     }
 
     /// Reads grid `index` of `path` once.
-    fn grid(&mut self, path: &Path, cbrk: bool, index: usize) -> Result<&BrickVolume, String> {
+    fn grid(&mut self, path: &Path, cbrk: bool, index: usize) -> Result<&BrickVolume> {
         let key = (path.to_path_buf(), index);
         if !self.grids.contains_key(&key) {
             let volume = if cbrk {
                 self.cbrk_bytes += std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-                read_cbrk(path).map_err(|e| e.to_string())?
+                read_cbrk_file(path)?
             } else {
-                let f = self.open(path)?;
-                let g = f.read_grid(index).map_err(|e| e.to_string())?;
-                convert(&g, Precision::F32).map_err(|e| format!("{}: {e}", path.display()))?
+                read_bricks(self.open(path)?, index)?
             };
             self.grids.insert(key.clone(), volume);
         }
@@ -190,13 +175,13 @@ impl Files {
     }
 
     /// The world box of a plan's density grid, loading it.
-    pub fn density_box(&mut self, p: &Plan) -> Result<WorldBox, String> {
+    pub fn density_box(&mut self, p: &Plan) -> Result<WorldBox> {
         let v = self.grid(&p.file, p.cbrk, p.density)?;
         let m = p.object_to_world * v.local_from_world().inverse();
         Ok(world_box_of(m, DVec3::ZERO, v.local_extent().as_dvec3()))
     }
 
-    pub fn load_grids(&mut self, p: &Plan) -> Result<(), String> {
+    pub fn load_grids(&mut self, p: &Plan) -> Result<()> {
         self.grid(&p.file, p.cbrk, p.density)?;
         for index in [p.temperature, p.emission].into_iter().flatten() {
             self.grid(&p.file, p.cbrk, index)?;
@@ -206,11 +191,7 @@ impl Files {
 
     /// The instance of a plan whose grids are loaded, placed in render
     /// space (world minus `centre`).
-    pub fn instance(
-        &self,
-        p: &Plan,
-        centre: DVec3,
-    ) -> Result<VolumeInstance<BrickField<'_>>, String> {
+    pub fn instance(&self, p: &Plan, centre: DVec3) -> Result<VolumeInstance<BrickField<'_>>> {
         let field = |index: usize| {
             let v = &self.grids[&(p.file.clone(), index)];
             BrickField::new(v, p.object_to_world, centre)
@@ -218,19 +199,19 @@ impl Files {
         let density = field(p.density);
         let density_scale = p
             .density_scale
-            .unwrap_or_else(|| 0.5 / density.voxel_size());
+            .unwrap_or_else(|| d::DENSITY_SCALE_PER_VOXEL / density.voxel_size());
         if !(density_scale.is_finite() && density_scale >= 0.0) {
-            return Err(format!(
+            return Err(Error::input(format!(
                 "{}: density scale must be finite and >= 0, got {density_scale}",
                 p.file.display()
-            ));
+            )));
         }
         if !p.albedo.is_finite() || p.albedo.min_element() < 0.0 || p.albedo.max_element() > 1.0 {
-            return Err(format!(
+            return Err(Error::input(format!(
                 "{}: albedo must lie in [0, 1], got {}",
                 p.file.display(),
                 p.albedo
-            ));
+            )));
         }
         let mut inst = VolumeInstance::new(density, density_scale, p.albedo, p.g);
         if p.emits() {

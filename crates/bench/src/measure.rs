@@ -3,8 +3,8 @@
 //! the density along a ray (1.0 is the physical limit; delta tracking's
 //! null collisions per real collision grow with it).
 
-use crate::dda::RaySegment;
-use crate::volume::BrickVolume;
+use cirrus_bricks::BrickVolume;
+use cirrus_bricks::RaySegment;
 use glam::Vec3;
 use std::time::Instant;
 

@@ -1,4 +1,4 @@
-//! Which volumes of a scene file must be loaded at all.
+//! Which volumes of a scene must be loaded at all.
 //!
 //! The rule, exact (it never drops light the renderer could have found):
 //! a path reaches a volume only by a camera ray, by a shadow ray, or by a

@@ -1,0 +1,187 @@
+//! The command-line form of [`Overrides`]: `clap` arguments that the
+//! `cirrus` binary and the benchmarks share, so their flags cannot drift
+//! apart. A flag left out is `None`, so it never hides a scene file's value;
+//! the defaults shown in `--help` are the ones in `defaults.rs`.
+
+use std::path::PathBuf;
+
+use cirrus_render::exr_layers::Aov;
+use cirrus_render::{Crop, IntegratorKind, MajorantMode, TransmittanceEstimator};
+use glam::{DVec3, Vec3};
+
+use crate::overrides::Overrides;
+use crate::parse;
+
+fn point(s: &str) -> Result<DVec3, String> {
+    parse::triple(s).map(DVec3::from_array)
+}
+
+fn vec3(s: &str) -> Result<Vec3, String> {
+    parse::triple(s).map(|v| DVec3::from_array(v).as_vec3())
+}
+
+/// What to render and how: every flag but the outputs.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SceneFlags {
+    /// A .vdb, .nvdb or .cbrk file, or a scene file (.toml).
+    pub file: PathBuf,
+    /// The density grid [default: "density", else the first float grid].
+    #[arg(long)]
+    pub grid: Option<String>,
+    /// Image size [default: 512x512].
+    #[arg(long, value_parser = parse::resolution)]
+    pub res: Option<(u32, u32)>,
+    /// Samples per pixel [default: 64].
+    #[arg(long, conflicts_with = "time")]
+    pub spp: Option<u32>,
+    /// Render passes until this many seconds are spent.
+    #[arg(long)]
+    pub time: Option<f64>,
+    /// Same seed, same image, on any thread count [default: 0].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Camera position (world space) [default: framed on the volume].
+    #[arg(long, value_parser = point, allow_hyphen_values = true, requires = "camera_to")]
+    pub camera_from: Option<DVec3>,
+    #[arg(long, value_parser = point, allow_hyphen_values = true, requires = "camera_from")]
+    pub camera_to: Option<DVec3>,
+    /// [default: 0,1,0]
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true)]
+    pub camera_up: Option<Vec3>,
+    /// Vertical field of view in degrees [default: 40].
+    #[arg(long)]
+    pub fov: Option<f32>,
+    /// Direction the sunlight travels, from the sun toward the scene [default: 0.7,-0.5,0.5].
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true)]
+    pub sun_dir: Option<Vec3>,
+    /// Sun irradiance on a surface facing it (W/m^2 per channel, Mitsuba's
+    /// `directional`) [default: 2.6,2.5,2.3].
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true)]
+    pub sun_irradiance: Option<Vec3>,
+    /// Angular diameter of the sun in degrees (0: a delta light) [default: 0.53].
+    #[arg(long)]
+    pub sun_angle: Option<f32>,
+    #[arg(long)]
+    pub no_sun: bool,
+    /// Constant sky radiance (0,0,0 for none) [default: 0.16,0.22,0.34].
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true)]
+    pub env_radiance: Option<Vec3>,
+    /// A lat-long HDR sky (EXR) instead of the constant radiance.
+    #[arg(long)]
+    pub env_map: Option<PathBuf>,
+    /// Rotation of the sky map about +Y, in degrees [default: 0].
+    #[arg(long, allow_hyphen_values = true)]
+    pub env_rotation: Option<f32>,
+    /// Multiplier of the sky map's radiance [default: 1].
+    #[arg(long)]
+    pub env_intensity: Option<f32>,
+    /// Extinction per unit density, in 1/world units [default: 0.5 / voxel
+    /// size, so density 1 is half a mean free path per voxel].
+    #[arg(long)]
+    pub density_scale: Option<f32>,
+    /// Single-scattering albedo [default: 0.99].
+    #[arg(long)]
+    pub albedo: Option<f32>,
+    /// Henyey-Greenstein asymmetry [default: 0.6].
+    #[arg(long, allow_hyphen_values = true)]
+    pub g: Option<f32>,
+    /// Real scattering events per path (0: only the sky through the volume,
+    /// 1: single scattering) [default: unlimited, ended by Russian roulette].
+    #[arg(long)]
+    pub max_depth: Option<u32>,
+    /// [default: path]
+    #[arg(long, value_enum)]
+    pub integrator: Option<IntegratorKind>,
+    /// Shadow-ray transmittance estimator [default: residual].
+    #[arg(long, value_enum)]
+    pub transmittance: Option<TransmittanceEstimator>,
+    /// Majorants for tracking: the brick hierarchy, or one global majorant
+    /// (Mitsuba-like) [default: hierarchy].
+    #[arg(long, value_enum)]
+    pub majorant: Option<MajorantMode>,
+    /// Majorant cells are refined while crossing one would cost more than
+    /// this many extra null collisions (optical depth; Blender Cycles uses
+    /// 1.442; 0 refines to the finest 4^3 cells) [default: 1].
+    #[arg(long)]
+    pub refine_optical_depth: Option<f32>,
+    /// Ray-march step in voxels [default: 0.5].
+    #[arg(long)]
+    pub step: Option<f32>,
+    /// Denoise with Intel Open Image Denoise 2.x (guided by the albedo
+    /// AOV); the EXR keeps the noisy image as `noisy.R/G/B`.
+    #[arg(long)]
+    pub denoise: bool,
+}
+
+/// Where the image goes.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct OutputFlags {
+    /// Output EXR (RGBA f32; alpha = 1 - camera-ray transmittance); a
+    /// scene file may give it instead (`[output] exr`).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Also write an sRGB PNG preview.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Exposure of the PNG preview, in stops [default: 0].
+    #[arg(long, allow_hyphen_values = true)]
+    pub exposure: Option<f32>,
+    /// Write render statistics as JSON.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// AOV layers to add to the EXR.
+    #[arg(long, value_delimiter = ',', value_enum)]
+    pub aov: Vec<Aov>,
+    /// Render only the pixels [x0, x1) x [y0, y1) into a full-size EXR with
+    /// a data window (merge tiles with `cirrus merge`).
+    #[arg(long, value_parser = parse::crop)]
+    pub crop: Option<Crop>,
+}
+
+impl SceneFlags {
+    /// The flags given, as overrides (outputs left unset).
+    pub fn overrides(&self) -> Overrides {
+        Overrides {
+            grid: self.grid.clone(),
+            density_scale: self.density_scale,
+            albedo: self.albedo,
+            g: self.g,
+            spp: self.spp,
+            time: self.time,
+            seed: self.seed,
+            integrator: self.integrator,
+            transmittance: self.transmittance,
+            majorant: self.majorant,
+            max_depth: self.max_depth,
+            step: self.step,
+            refine_optical_depth: self.refine_optical_depth,
+            denoise: self.denoise.then_some(true),
+            res: self.res,
+            camera_from: self.camera_from,
+            camera_to: self.camera_to,
+            camera_up: self.camera_up,
+            fov: self.fov,
+            sun: self.no_sun.then_some(false),
+            sun_dir: self.sun_dir,
+            sun_irradiance: self.sun_irradiance,
+            sun_angle: self.sun_angle,
+            env_radiance: self.env_radiance,
+            env_map: self.env_map.clone(),
+            env_rotation: self.env_rotation,
+            env_intensity: self.env_intensity,
+            ..Default::default()
+        }
+    }
+}
+
+impl OutputFlags {
+    /// Writes the output flags given into `o`.
+    pub fn write_into(&self, o: &mut Overrides) {
+        o.output = self.output.clone();
+        o.png = self.png.clone();
+        o.exposure = self.exposure;
+        o.stats = self.stats.clone();
+        o.aov = (!self.aov.is_empty()).then(|| self.aov.clone());
+        o.crop = self.crop;
+    }
+}

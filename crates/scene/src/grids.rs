@@ -1,0 +1,66 @@
+//! Which grid of a file is the density, and reading one into bricks.
+
+use std::path::Path;
+
+use cirrus_bricks::{convert, read_cbrk, BrickVolume, Precision};
+use cirrus_vdb::{GridInfo, ValueType, VolumeFile};
+
+use crate::defaults::DENSITY_GRID;
+use crate::error::{Error, Result};
+
+/// The grid to render or convert: the one named, else "density", else
+/// the first float grid.
+pub fn choose_grid(file: &VolumeFile, name: Option<&str>) -> Result<usize> {
+    if let Some(name) = name {
+        return file
+            .find_grid(name)
+            .map_err(|e| Error::input(e.to_string()));
+    }
+    let grids = file.grids();
+    let float = |g: &&GridInfo| g.value_type == Some(ValueType::Float);
+    grids
+        .iter()
+        .position(|g| g.name == DENSITY_GRID && float(g))
+        .or_else(|| grids.iter().position(float))
+        .ok_or_else(|| {
+            let names: Vec<String> = grids
+                .iter()
+                .map(|g| format!("{} ({})", g.name, g.type_name))
+                .collect();
+            Error::input(format!(
+                "{}: no float grid to use (grids: {})",
+                file.path().display(),
+                names.join(", ")
+            ))
+        })
+}
+
+/// Grid `index` of an open file as f32 bricks.
+pub fn read_bricks(file: &VolumeFile, index: usize) -> Result<BrickVolume> {
+    let grid = file.read_grid(index)?;
+    convert(&grid, Precision::F32)
+        .map_err(|e| Error::input(format!("{}: {e}", file.path().display())))
+}
+
+/// A `.cbrk` file, whole.
+pub fn read_cbrk_file(path: &Path) -> Result<BrickVolume> {
+    // The format's errors name the file already.
+    read_cbrk(path).map_err(|e| Error::file(e.to_string()))
+}
+
+/// The density volume of a `.vdb`/`.nvdb` (converted at f32) or a `.cbrk`,
+/// and the bytes read from disk for it (a `.cbrk` counts whole).
+pub fn load_volume(path: &Path, grid: Option<&str>) -> Result<(BrickVolume, u64)> {
+    if is_cbrk(path) {
+        let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+        return Ok((read_cbrk_file(path)?, bytes));
+    }
+    let f = VolumeFile::open(path)?;
+    let index = choose_grid(&f, grid)?;
+    let volume = read_bricks(&f, index)?;
+    Ok((volume, f.bytes_read()))
+}
+
+pub fn is_cbrk(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "cbrk")
+}

@@ -1,0 +1,57 @@
+//! The cirrus scene model: what to render, read from a scene file, a lone
+//! volume file or code, and rendered without the command line.
+//!
+//! How the parts fit:
+//!
+//! - [`SceneDescription`] is exactly the TOML format of a scene file (and
+//!   the JSON form of a Python dict). [`Overrides`] are the flags of
+//!   `cirrus render` as plain optional fields written over it; with the
+//!   `clap` feature, [`SceneFlags`] and [`OutputFlags`] are their
+//!   command-line form. Every default lives in [`defaults`].
+//! - [`Scene`] holds a description and renders it: it resolves the
+//!   scene-wide [`SceneSettings`], plans each volume from its file's header,
+//!   culls the volumes no path can reach, reads only the grids that can
+//!   matter, and renders through `cirrus-render`. [`LoneVolume`] is one
+//!   volume loaded whole, which the benchmarks render many times.
+//! - [`Outputs`] writes the EXR, PNG and statistics whole or not at all.
+//! - [`info::file_report`] is the report of `cirrus info --json`;
+//!   [`dense::read_dense`] reads a grid into a dense array.
+//! - Every failure is an [`Error`] whose kind says whether a file or the
+//!   input was at fault, with the message the command line prints.
+//!
+//! ```
+//! use cirrus_scene::{Overrides, Scene};
+//!
+//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cloud.vdb");
+//! let mut scene = Scene::load(path.as_ref())?;
+//! scene.apply(&Overrides { res: Some((16, 12)), spp: Some(2), ..Default::default() });
+//! let rendered = scene.render()?;
+//! assert_eq!((rendered.image.width, rendered.image.height), (16, 12));
+//! # Ok::<(), cirrus_scene::Error>(())
+//! ```
+
+pub mod cull;
+pub mod defaults;
+mod denoise;
+pub mod dense;
+pub mod description;
+mod error;
+#[cfg(feature = "clap")]
+mod flags;
+pub mod grids;
+pub mod info;
+mod output;
+mod overrides;
+pub mod parse;
+mod plan;
+mod scene;
+mod settings;
+
+pub use description::SceneDescription;
+pub use error::{Error, ErrorKind, Result};
+#[cfg(feature = "clap")]
+pub use flags::{OutputFlags, SceneFlags};
+pub use output::{write_whole, Outputs};
+pub use overrides::Overrides;
+pub use scene::{LoneVolume, Scene};
+pub use settings::SceneSettings;

@@ -1,0 +1,62 @@
+//! The text forms of values on command lines and in scene files.
+
+use cirrus_render::Crop;
+
+/// Three finite numbers "x,y,z" (a leading minus is fine).
+pub fn triple(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|c| c.trim().parse::<f64>().map_err(|e| format!("{s:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([x, y, z]),
+        _ => Err(format!("expected three finite numbers x,y,z, got {s:?}")),
+    }
+}
+
+/// "WxH", each side 1 to 16384.
+pub fn resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH, got {s:?}"))?;
+    let w: u32 = w.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    let h: u32 = h.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!(
+            "resolution {w}x{h} must be between 1 and 16384 a side"
+        ));
+    }
+    Ok((w, h))
+}
+
+/// "x0,y0,x1,y1" in pixels.
+pub fn crop(s: &str) -> Result<Crop, String> {
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|c| c.trim().parse::<u32>().map_err(|e| format!("{s:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x0, y0, x1, y1] => Ok(Crop { x0, y0, x1, y1 }),
+        _ => Err(format!("expected x0,y0,x1,y1, got {s:?}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_forms_parse_and_refuse() {
+        assert_eq!(triple("1,-2.5, 3").unwrap(), [1.0, -2.5, 3.0]);
+        assert!(triple("1,2").is_err());
+        assert!(triple("1,2,nan").is_err());
+        assert_eq!(resolution("640x360").unwrap(), (640, 360));
+        assert_eq!(resolution("8X4").unwrap(), (8, 4));
+        assert!(resolution("0x4").is_err());
+        assert!(resolution("16385x4").is_err());
+        assert!(resolution("12by4").unwrap_err().contains("WxH"));
+        let c = crop("1,2,30,40").unwrap();
+        assert_eq!((c.x0, c.y0, c.x1, c.y1), (1, 2, 30, 40));
+        assert!(crop("1,2,3").is_err());
+    }
+}

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Every test of the project, as CI runs them: the Rust workspace (the
+# denoiser's tests with the real Open Image Denoise library from PyPI's
+# pyoidn), the Python module, and the Dask farm driver.
+# Needs: cargo, python3 (3.11+) with venv and pip, and the package indexes.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+python=${PYTHON:-python3}
+[ -x target/venv/bin/python ] || "$python" -m venv target/venv
+CIRRUS_OIDN=$(bash tools/oidn.sh target/venv/bin/python)
+export CIRRUS_OIDN
+cargo test --workspace --release
+bash tools/test_python.sh "$python"
+bash tools/test_farm.sh target/venv/bin/python
