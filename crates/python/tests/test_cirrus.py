@@ -71,10 +71,21 @@ def test_dense_read_matches_the_values_debian_wrote():
     # Every active value of this fog volume is positive and the rest are
     # the background 0, so the non-zeros are exactly the active voxels.
     assert np.count_nonzero(a) == m["active_voxels"]
-    assert len(m["samples"]) >= 10
-    for s in m["samples"]:
+    samples = m["samples"]
+    assert len(samples) >= 10 and any(not s["active"] for s in samples)
+    outside = 0
+    for s in samples:
         i, j, k = s["ijk"]
-        assert a[i - x0, j - y0, k - z0] == np.float32(s["value"]), s
+        if x0 <= i <= x1 and y0 <= j <= y1 and z0 <= k <= z1:
+            assert a[i - x0, j - y0, k - z0] == np.float32(s["value"]), s
+        else:
+            # Far outside the active box (the background): a box of one voxel.
+            one = g.read((s["ijk"], s["ijk"]))
+            assert one.shape == (1, 1, 1) and one[0, 0, 0] == np.float32(s["value"]), s
+            outside += 1
+    assert outside >= 5
+    with pytest.raises(ValueError, match="over the limit"):
+        g.read(((-2**31, -2**31, -2**31), (2**31 - 1, 2**31 - 1, 2**31 - 1)))
     box = g.read(((40, 50, 90), (41, 52, 93)))
     assert box.shape == (2, 3, 4)
     assert np.array_equal(box, a[40 - x0 : 42 - x0, 50 - y0 : 53 - y0, 90 - z0 : 94 - z0])

@@ -27,6 +27,13 @@ pub const SKY_INTENSITY: f32 = 1.0;
 pub const DENSITY_SCALE_PER_VOXEL: f32 = 0.5;
 pub const ALBEDO: f32 = 0.99;
 pub const G: f32 = 0.6;
+/// The back lobe of a two-lobe HG mix and the first lobe's weight.
+pub const G2: f32 = -0.3;
+pub const LOBE_WEIGHT: f32 = 0.8;
+/// Draine's alpha (1 gives Cornette and Shanks' form).
+pub const DRAINE_ALPHA: f32 = 1.0;
+/// A typical cloud droplet, micrometres.
+pub const DROPLET_DIAMETER: f32 = 20.0;
 pub const INTEGRATOR: IntegratorKind = IntegratorKind::Path;
 pub const TRANSMITTANCE: TransmittanceEstimator = TransmittanceEstimator::Residual;
 pub const MAJORANT: MajorantMode = MajorantMode::Hierarchy;

@@ -43,7 +43,10 @@ pub fn read_dense(path: &Path, name: &str, bbox: Option<([i32; 3], [i32; 3])>) -
         .map(|a| (i64::from(hi[a]) - i64::from(lo[a]) + 1).max(0) as u64)
         .collect();
     let n = tree.background_components().1;
-    let count = dims.iter().product::<u64>().saturating_mul(n as u64);
+    let count = dims
+        .iter()
+        .try_fold(n as u64, |acc, &d| acc.checked_mul(d))
+        .unwrap_or(u64::MAX);
     if count > MAX_DENSE_VALUES {
         return Err(Error::input(format!(
             "{}: a dense box of {}x{}x{} x {n} values is over the limit of {MAX_DENSE_VALUES}",

@@ -137,7 +137,19 @@ pub struct VolumeSpec {
     pub emission: Option<String>,
     pub density_scale: Option<f32>,
     pub albedo: Option<Colour>,
+    /// Mean cosine of the (first) Henyey-Greenstein lobe, or Draine's g.
     pub g: Option<f32>,
+    /// `hg`, `hg2`, `draine`, `mie`, `rayleigh` or `table:FILE` (a
+    /// two-column text file of cos(theta) and value).
+    pub phase: Option<String>,
+    /// The second lobe of `hg2`.
+    pub g2: Option<f32>,
+    /// Weight of the first lobe of `hg2`, in [0, 1].
+    pub lobe_weight: Option<f32>,
+    /// Droplet diameter of `mie`, micrometres (5 to 50).
+    pub droplet_diameter: Option<f32>,
+    /// Draine's alpha.
+    pub draine_alpha: Option<f32>,
     #[serde(default)]
     pub transform: TransformSpec,
     #[serde(default)]
@@ -220,6 +232,9 @@ impl SceneDescription {
     pub fn rebase(&mut self, dir: &Path) {
         for v in &mut self.volumes {
             v.file = dir.join(&v.file);
+            if let Some(table) = v.phase.as_deref().and_then(|p| p.strip_prefix("table:")) {
+                v.phase = Some(format!("table:{}", dir.join(table).display()));
+            }
         }
         if let Some(map) = self.environment.as_mut().and_then(|e| e.map.as_mut()) {
             *map = dir.join(&*map);

@@ -82,9 +82,27 @@ pub struct SceneFlags {
     /// Single-scattering albedo [default: 0.99].
     #[arg(long)]
     pub albedo: Option<f32>,
-    /// Henyey-Greenstein asymmetry [default: 0.6].
+    /// Henyey-Greenstein asymmetry (of the first lobe of hg2; Draine's g)
+    /// [default: 0.6].
     #[arg(long, allow_hyphen_values = true)]
     pub g: Option<f32>,
+    /// Phase function: hg, hg2 (two HG lobes), draine, mie (Jendersie and
+    /// d'Eon 2023's fit by droplet diameter), rayleigh, or table:FILE (two
+    /// columns, cos(theta) and value) [default: hg].
+    #[arg(long)]
+    pub phase: Option<String>,
+    /// The second lobe of hg2 [default: -0.3].
+    #[arg(long, allow_hyphen_values = true)]
+    pub g2: Option<f32>,
+    /// Weight of hg2's first lobe, in [0, 1] [default: 0.8].
+    #[arg(long)]
+    pub lobe_weight: Option<f32>,
+    /// Droplet diameter of mie, in micrometres (5 to 50) [default: 20].
+    #[arg(long)]
+    pub droplet_diameter: Option<f32>,
+    /// Draine's alpha [default: 1].
+    #[arg(long)]
+    pub draine_alpha: Option<f32>,
     /// Real scattering events per path (0: only the sky through the volume,
     /// 1: single scattering) [default: unlimited, ended by Russian roulette].
     #[arg(long)]
@@ -146,6 +164,11 @@ impl SceneFlags {
             density_scale: self.density_scale,
             albedo: self.albedo,
             g: self.g,
+            phase: self.phase.clone(),
+            g2: self.g2,
+            lobe_weight: self.lobe_weight,
+            droplet_diameter: self.droplet_diameter,
+            draine_alpha: self.draine_alpha,
             spp: self.spp,
             time: self.time,
             seed: self.seed,

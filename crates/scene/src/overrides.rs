@@ -22,6 +22,11 @@ pub struct Overrides {
     pub density_scale: Option<f32>,
     pub albedo: Option<f32>,
     pub g: Option<f32>,
+    pub phase: Option<String>,
+    pub g2: Option<f32>,
+    pub lobe_weight: Option<f32>,
+    pub droplet_diameter: Option<f32>,
+    pub draine_alpha: Option<f32>,
     // Render.
     pub spp: Option<u32>,
     pub time: Option<f64>,
@@ -90,6 +95,11 @@ impl Overrides {
             set(&mut v.density_scale, self.density_scale);
             set(&mut v.albedo, self.albedo.map(Colour::Grey));
             set(&mut v.g, self.g);
+            set(&mut v.phase, self.phase.clone());
+            set(&mut v.g2, self.g2);
+            set(&mut v.lobe_weight, self.lobe_weight);
+            set(&mut v.droplet_diameter, self.droplet_diameter);
+            set(&mut v.draine_alpha, self.draine_alpha);
         }
         let r = &mut d.render;
         if self.spp.is_some() || self.time.is_some() {

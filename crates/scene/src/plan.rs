@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use cirrus_bricks::BrickVolume;
 use cirrus_render::medium::BrickField;
-use cirrus_render::{Blackbody, DensityField, VolumeInstance};
+use cirrus_render::{Blackbody, DensityField, Phase, VolumeInstance};
 use cirrus_vdb::VolumeFile;
 use glam::{DMat4, DVec3, Vec3};
 
@@ -29,7 +29,7 @@ pub struct Plan {
     pub world_box: Option<WorldBox>,
     density_scale: Option<f32>,
     albedo: Vec3,
-    g: f32,
+    phase: Phase,
     blackbody: Blackbody,
     emission_colour: Vec3,
 }
@@ -115,7 +115,7 @@ pub fn plan(v: &VolumeSpec, files: &mut Files) -> Result<Plan> {
         albedo: v
             .albedo
             .map_or(Vec3::splat(d::ALBEDO), |a| Vec3::from_array(a.rgb())),
-        g: v.g.unwrap_or(d::G),
+        phase: phase_of(v)?,
         blackbody: Blackbody {
             scale: bb.scale.unwrap_or(1.0),
             offset: bb.offset.unwrap_or(0.0),
@@ -124,6 +124,30 @@ pub fn plan(v: &VolumeSpec, files: &mut Files) -> Result<Plan> {
         emission_colour: Vec3::from_array(v.emission_color.unwrap_or([1.0; 3]))
             * v.emission_scale.unwrap_or(1.0),
     })
+}
+
+/// The phase function a volume names, with the defaults filled in.
+pub fn phase_of(v: &VolumeSpec) -> Result<Phase> {
+    let g = v.g.unwrap_or(d::G);
+    let name = v.phase.as_deref().unwrap_or("hg");
+    let phase = match name {
+        "hg" => Ok(Phase::hg(g)),
+        "hg2" => Phase::hg2(
+            g,
+            v.g2.unwrap_or(d::G2),
+            v.lobe_weight.unwrap_or(d::LOBE_WEIGHT),
+        ),
+        "draine" => Phase::draine(g, v.draine_alpha.unwrap_or(d::DRAINE_ALPHA)),
+        "mie" => Phase::mie(v.droplet_diameter.unwrap_or(d::DROPLET_DIAMETER)),
+        "rayleigh" => Ok(Phase::rayleigh()),
+        _ => match name.strip_prefix("table:") {
+            Some(path) => return Phase::read_table(path).map_err(Error::file),
+            None => Err(format!(
+                "phase {name:?}: expected hg, hg2, draine, mie, rayleigh or table:FILE"
+            )),
+        },
+    };
+    phase.map_err(|e| Error::input(format!("{}: {e}", v.file.display())))
 }
 
 /// The world box of the local box `[lo, hi]` under `m`.
@@ -213,7 +237,8 @@ impl Files {
                 p.albedo
             )));
         }
-        let mut inst = VolumeInstance::new(density, density_scale, p.albedo, p.g);
+        let mut inst = VolumeInstance::new(density, density_scale, p.albedo, d::G)
+            .with_phase(p.phase.clone());
         if p.emits() {
             inst.emission = Some(cirrus_render::Emission {
                 temperature: p.temperature.map(|i| (field(i), p.blackbody)),

@@ -219,8 +219,9 @@ impl LoneVolume {
             .spec
             .albedo
             .map_or(Vec3::splat(d::ALBEDO), |a| Vec3::from_array(a.rgb()));
+        let phase = crate::plan::phase_of(&self.spec)?;
         let scene = cirrus_render::Scene {
-            medium: Medium::new(field, density_scale, albedo, self.spec.g.unwrap_or(d::G)),
+            medium: Medium::new(field, density_scale, albedo, d::G).with_phase(phase),
             camera,
             lights: s.lights.clone(),
         };
