@@ -215,7 +215,14 @@ impl Files {
 
     /// The instance of a plan whose grids are loaded, placed in render
     /// space (world minus `centre`).
-    pub fn instance(&self, p: &Plan, centre: DVec3) -> Result<VolumeInstance<BrickField<'_>>> {
+    /// Its majorant cells are refined for its density scale, as a lone
+    /// volume's are (`refine`: the optical depth a cell may waste).
+    pub fn instance(
+        &self,
+        p: &Plan,
+        centre: DVec3,
+        refine: f32,
+    ) -> Result<VolumeInstance<BrickField<'_>>> {
         let field = |index: usize| {
             let v = &self.grids[&(p.file.clone(), index)];
             BrickField::new(v, p.object_to_world, centre)
@@ -237,8 +244,9 @@ impl Files {
                 p.albedo
             )));
         }
-        let mut inst = VolumeInstance::new(density, density_scale, p.albedo, d::G)
-            .with_phase(p.phase.clone());
+        let density = density.with_refinement(density_scale, refine);
+        let mut inst =
+            VolumeInstance::new(density, density_scale, p.albedo, d::G).with_phase(p.phase.clone());
         if p.emits() {
             inst.emission = Some(cirrus_render::Emission {
                 temperature: p.temperature.map(|i| (field(i), p.blackbody)),

@@ -296,7 +296,7 @@ fn render_file(
         files.load_grids(p)?;
     }
     let instances = kept()
-        .map(|p| files.instance(p, centre))
+        .map(|p| files.instance(p, centre, settings.refine_optical_depth))
         .collect::<Result<Vec<_>>>()?;
     let volumes = Volumes::new(instances);
     if volumes.instances().is_empty() {

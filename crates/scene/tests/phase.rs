@@ -42,7 +42,10 @@ fn bad_phases_are_input_errors_naming_what_is_wrong() {
     })
     .unwrap_err();
     assert_eq!(e.kind, ErrorKind::Input);
-    assert!(e.message.contains("mei") && e.message.contains("rayleigh"), "{e}");
+    assert!(
+        e.message.contains("mei") && e.message.contains("rayleigh"),
+        "{e}"
+    );
     let e = render(Overrides {
         phase: Some("mie".into()),
         droplet_diameter: Some(0.5),
