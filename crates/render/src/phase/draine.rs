@@ -58,9 +58,11 @@ impl Lobe for Draine {
 
     /// Exact inversion of the CDF (the function's own density, no
     /// weights), in f64: for `g != 0` the unique positive root of a
-    /// quartic ([`quartic_root`]), for `g = 0` a cubic ([`symmetric_cubic`]).
-    /// Jendersie and d'Eon (2023, supplemental) give an equivalent closed
-    /// form; this one is derived below.
+    /// quartic (`quartic_root`), for `g = 0` a cubic (`symmetric_cubic`).
+    /// Jendersie and d'Eon (2023, supplemental) publish a closed form of
+    /// their own (Blender Cycles' `phase_draine_sample_cos` adapts it, in
+    /// f32); this one is derived below, in an arrangement without
+    /// cancellation, and tested against the CDF at extreme parameters.
     fn sample_cos(&self, u: f32) -> f32 {
         let g = self.hg.g();
         if self.alpha == 0.0 {
@@ -153,12 +155,17 @@ fn quartic_root(g: f64, alpha: f64, v: f64) -> f64 {
 /// with `g = 0`; Rayleigh at `alpha = 1`). The CDF is
 /// `(mu + alpha mu^3 / 3 + 1 + alpha / 3) / (2 (1 + alpha / 3))`, so `mu`
 /// solves `mu^3 + (3 / alpha) mu = 3 c / alpha`, `c = (2 u - 1)(1 + alpha / 3)`:
-/// a depressed cubic with positive linear coefficient, whose one real
-/// root in the hyperbolic form of Cardano's formula is
-/// `(2 / sqrt(alpha)) sinh(asinh(1.5 c sqrt(alpha)) / 3)`, stable for every
-/// `alpha > 0` (it tends to `mu = c` as `alpha -> 0`).
+/// a depressed cubic with positive linear coefficient, so one real root,
+/// which Cardano's formula gives as
+/// `(2 / sqrt(alpha)) sinh(asinh(w) / 3)`, `w = 1.5 c sqrt(alpha)`. With
+/// `A = cbrt(|w| + sqrt(w^2 + 1)) = exp(asinh(|w|) / 3)` that is
+/// `sign(w) (A - 1 / A) / sqrt(alpha)`: a cube root instead of two
+/// transcendental calls, and no cancellation in `A` (the odd symmetry
+/// handles `w < 0`). It tends to `mu = c` as `alpha -> 0`.
 pub(super) fn symmetric_cubic(alpha: f64, u: f64) -> f64 {
     let c = (2.0 * u - 1.0) * (1.0 + alpha / 3.0);
     let sa = alpha.sqrt();
-    2.0 / sa * ((1.5 * c * sa).asinh() / 3.0).sinh()
+    let w = 1.5 * c * sa;
+    let a = (w.abs() + (w * w + 1.0).sqrt()).cbrt();
+    ((a - 1.0 / a) / sa).copysign(w)
 }

@@ -39,7 +39,7 @@ use glam::Vec3;
 pub use blend::Blend;
 pub use draine::Draine;
 pub use hg::{HenyeyGreenstein, MAX_ABS_G};
-pub use mie::MieFit;
+pub use mie::{MieFit, MIE_DIAMETER_RANGE_UM};
 pub use rayleigh::Rayleigh;
 pub use table::{TabulatedPhase, MAX_TABLE_ROWS};
 

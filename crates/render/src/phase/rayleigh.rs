@@ -17,7 +17,7 @@ impl Lobe for Rayleigh {
 
     /// Exact: the CDF `(mu^3 + 3 mu + 4) / 8` inverted in closed form,
     /// `mu = 2 sinh(asinh(4 u - 2) / 3)` (Cardano's formula for the cubic;
-    /// it is Draine's `g = 0` case at `alpha = 1`).
+    /// it is Draine's `g = 0` case at `alpha = 1`, computed there).
     #[inline]
     fn sample_cos(&self, u: f32) -> f32 {
         (symmetric_cubic(1.0, f64::from(u)) as f32).clamp(-1.0, 1.0)

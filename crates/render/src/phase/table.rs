@@ -143,7 +143,7 @@ pub(super) fn validate(cos_values: &[f32], values: &[f32]) -> Result<(), TableEr
         return Err(whole(format!("needs 2 to {MAX_TABLE_ROWS} rows, got {n}")));
     }
     for (i, (&c, &v)) in cos_values.iter().zip(values).enumerate() {
-        if !(c.abs() <= 1.0 + END_TOLERANCE) {
+        if c.is_nan() || c.abs() > 1.0 + END_TOLERANCE {
             return Err(at(i, format!("cos(theta) must be in [-1, 1], got {c}")));
         }
         if !(v.is_finite() && v >= 0.0) {
