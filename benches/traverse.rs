@@ -3,7 +3,8 @@
 //! `cargo bench --bench traverse`. (`cirrus bench traverse FILE` prints
 //! the same comparison with tightness for any file.)
 
-use cirrus::bricks::{convert, FixedMajorantGrid, GlobalMajorant, Precision};
+use cirrus::bricks::{convert, Precision};
+use cirrus_bench::baseline::{FixedMajorantGrid, GlobalMajorant};
 use cirrus_bench::measure::random_rays;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;

@@ -1,9 +1,8 @@
 //! The brick hierarchy on the corpus cloud: the bounds it promises, measured.
 
-use cirrus::bricks::{
-    convert, read_cbrk, write_cbrk, FixedMajorantGrid, GlobalMajorant, Precision,
-};
+use cirrus::bricks::{convert, read_cbrk, write_cbrk, Precision};
 use cirrus::vdb::VolumeFile;
+use cirrus_bench::baseline::{FixedMajorantGrid, GlobalMajorant};
 use cirrus_bench::measure::{density_integral, measure, random_rays};
 use std::path::Path;
 

@@ -9,6 +9,7 @@
 //! 1 / (MSE x time), reported relative to the Mitsuba-like baseline (delta
 //! tracking + ratio tracking over one global majorant) at the same budget.
 
+use crate::fixed_grid::FixedGridField;
 use crate::BenchResult;
 use cirrus_render::medium::BrickField;
 use cirrus_render::{
@@ -167,8 +168,10 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
         } = s;
         Scene {
             medium: Medium {
-                field: medium.field.with_fixed_grid(args.fixed_res),
-                ..medium
+                field: FixedGridField::new(medium.field, args.fixed_res),
+                density_scale: medium.density_scale,
+                albedo: medium.albedo,
+                phase: medium.phase,
             },
             camera,
             lights,
@@ -189,12 +192,11 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
         ..base.clone()
     };
     let render_with = |c: &Config, s: &RenderSettings| {
-        let scene: &Scene<BrickField> = if c.structure == Structure::Fixed {
-            &fixed_scene
+        if c.structure == Structure::Fixed {
+            render(&fixed_scene, s)
         } else {
-            &scene
-        };
-        render(scene, s)
+            render(&scene, s)
+        }
     };
 
     let reference = match &args.reference {
@@ -286,7 +288,8 @@ fn collision_cost_ns(medium: &Medium<BrickField>) -> f64 {
     use cirrus_render::tracking::sample_free_flight;
     use cirrus_render::{Ray, Rng};
     let global = GlobalMedia::new(medium);
-    let (lo, hi) = global.bounds();
+    let b = global.bounds();
+    let (lo, hi) = (b.min, b.max);
     let mut best = f64::INFINITY;
     // Best of three: the least disturbed by other work on the machine.
     for _ in 0..3 {

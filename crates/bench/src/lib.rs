@@ -2,7 +2,8 @@
 //!
 //! - [`traverse`]: majorant structures (one global bound, a fixed
 //!   pbrt-style grid, the brick hierarchy) side by side on the same random
-//!   rays, with the ray-level measures in [`measure`];
+//!   rays, with the ray-level measures in [`measure`] and the baselines in
+//!   [`baseline`] ([`fixed_grid`] renders through the fixed grid);
 //! - [`error`]: run time against error for every estimator and majorant
 //!   structure, against a converged reference, plotted by [`plot`];
 //! - [`stress`]: extreme inputs, each checked for finite images and, where
@@ -11,7 +12,9 @@
 //! Speeds are printed as ratios against a baseline measured in the same
 //! run; nothing here asserts a time.
 
+pub mod baseline;
 pub mod error;
+pub mod fixed_grid;
 pub mod measure;
 pub mod plot;
 pub mod stress;

@@ -4,7 +4,7 @@
 //! null collisions per real collision grow with it).
 
 use cirrus_bricks::BrickVolume;
-use cirrus_bricks::RaySegment;
+use cirrus_bricks::MajorantSegment;
 use glam::Vec3;
 use std::time::Instant;
 
@@ -75,7 +75,7 @@ pub struct TraversalReport {
 
 /// Runs `walk` over every ray (timed), then measures tightness against the
 /// precomputed density integrals.
-pub fn measure<I: Iterator<Item = RaySegment>>(
+pub fn measure<I: Iterator<Item = MajorantSegment>>(
     name: &str,
     rays: &[LocalRay],
     integrals: &[f64],

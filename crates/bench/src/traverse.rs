@@ -1,9 +1,10 @@
 //! `cirrus bench traverse FILE`: majorant structures side by side on the
 //! same random rays, plus conversion speed and memory.
 
+use crate::baseline::{FixedMajorantGrid, GlobalMajorant};
 use crate::measure::{density_integral, measure, random_rays, TraversalReport};
 use crate::BenchResult;
-use cirrus_bricks::{convert, FixedMajorantGrid, GlobalMajorant, Precision};
+use cirrus_bricks::{convert, Precision};
 use cirrus_vdb::VolumeFile;
 use std::path::PathBuf;
 use std::time::Instant;

@@ -39,24 +39,17 @@
 //! so the walk ends after at most (length / nudge) steps whatever the
 //! rounding: no infinite loop for rays along faces, edges or corners.
 
+use crate::aabb::Bounds3;
 use crate::bounds::CELL_LOG2;
 use crate::partition::{Cell, CellPartition};
+use crate::segment::MajorantSegment;
 use crate::volume::BrickVolume;
 use glam::Vec3;
 
 /// A cell with `minorant >= TIGHT_ENOUGH * majorant` is not refined.
 pub const TIGHT_ENOUGH: f32 = 0.5;
 
-/// Over `[t0, t1]` the density lies within `[minorant, majorant]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RaySegment {
-    pub t0: f32,
-    pub t1: f32,
-    pub minorant: f32,
-    pub majorant: f32,
-}
-
-/// Iterator of [`RaySegment`]s; see the module doc.
+/// Iterator of [`MajorantSegment`]s; see the module doc.
 pub struct SegmentIter<'a> {
     volume: &'a BrickVolume,
     partition: &'a CellPartition,
@@ -65,23 +58,13 @@ pub struct SegmentIter<'a> {
     inv_dir: Vec3,
     t: f32,
     t_end: f32,
-    pending: Option<RaySegment>,
+    pending: Option<MajorantSegment>,
     /// Pyramid steps taken (cells visited), for statistics.
     pub steps: u32,
     /// Absolute part of the nudge: 1e-5 voxels along the ray's major axis.
     nudge_abs: f32,
     /// Per axis, whether the ray leaves a cell through its upper face.
     upward: glam::BVec3,
-}
-
-/// Slab test of a ray against the box [lo, hi]: the parameter interval inside.
-pub fn ray_box(origin: Vec3, inv_dir: Vec3, lo: Vec3, hi: Vec3) -> (f32, f32) {
-    let a = (lo - origin) * inv_dir;
-    let b = (hi - origin) * inv_dir;
-    // NaN (0 * inf for a ray on a slab face) is dropped by min/max.
-    let t0 = a.min(b).max_element();
-    let t1 = a.max(b).min_element();
-    (t0, t1)
 }
 
 impl<'a> SegmentIter<'a> {
@@ -94,7 +77,7 @@ impl<'a> SegmentIter<'a> {
         t_max: f32,
     ) -> Self {
         let inv_dir = dir.recip();
-        let (b0, b1) = ray_box(origin, inv_dir, Vec3::ZERO, volume.local_extent());
+        let (b0, b1) = Bounds3::new(Vec3::ZERO, volume.local_extent()).slab(origin, inv_dir);
         // For exits: a zero component never exits (+inf, whatever the sign of zero).
         let inv_dir = Vec3::select(dir.cmpeq(Vec3::ZERO), Vec3::INFINITY, inv_dir);
         let valid = origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO;
@@ -119,7 +102,7 @@ impl<'a> SegmentIter<'a> {
     }
 
     /// The next raw (unmerged) segment, or `None` at the end of the ray.
-    fn step(&mut self) -> Option<RaySegment> {
+    fn step(&mut self) -> Option<MajorantSegment> {
         let levels = &self.volume.levels;
         while self.t < self.t_end {
             self.steps += 1;
@@ -167,7 +150,7 @@ impl<'a> SegmentIter<'a> {
             let t0 = self.leave(cell_lo, cell_lo + Vec3::splat(size), nudge);
             let t1 = self.t;
             if hi > 0.0 {
-                return Some(RaySegment {
+                return Some(MajorantSegment {
                     t0,
                     t1,
                     minorant: lo,
@@ -193,16 +176,16 @@ impl<'a> SegmentIter<'a> {
 }
 
 impl Iterator for SegmentIter<'_> {
-    type Item = RaySegment;
+    type Item = MajorantSegment;
 
-    fn next(&mut self) -> Option<RaySegment> {
+    fn next(&mut self) -> Option<MajorantSegment> {
         loop {
             match (self.step(), self.pending) {
                 (None, _) => return self.pending.take(),
                 (Some(s), None) => self.pending = Some(s),
                 (Some(s), Some(p)) => {
                     if p.t1 == s.t0 && p.majorant == s.majorant && p.minorant == s.minorant {
-                        self.pending = Some(RaySegment { t1: s.t1, ..p });
+                        self.pending = Some(MajorantSegment { t1: s.t1, ..p });
                     } else {
                         self.pending = Some(s);
                         return Some(p);

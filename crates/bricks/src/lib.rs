@@ -7,13 +7,13 @@
 //! (min, max) bounds per brick and per coarser cell (`bounds.rs`) that bound
 //! the trilinearly interpolated density. [`SegmentIter`] (`dda.rs`) walks a
 //! ray through the pyramid front to back, skipping empty space at the
-//! coarsest level and yielding [`RaySegment`]s with tight bounds, over the
+//! coarsest level and yielding [`MajorantSegment`]s with tight bounds, over the
 //! cells of a [`CellPartition`] (`partition.rs`) fixed once per refinement rule;
 //! [`BrickVolume::trilinear`] is the density lookup. `format.rs` writes and
-//! memory-maps the `.cbrk` file of a converted volume, and `baseline.rs`
-//! builds the coarser majorant structures the benchmarks compare against.
+//! memory-maps the `.cbrk` file of a converted volume. [`Bounds3`] and
+//! [`DBounds3`] (`aabb.rs`) are the box types of the whole workspace.
 
-mod baseline;
+mod aabb;
 mod bounds;
 mod convert;
 mod dda;
@@ -21,16 +21,18 @@ mod format;
 mod layout;
 mod partition;
 mod section;
+mod segment;
 mod volume;
 
-pub use baseline::{FixedGridIter, FixedMajorantGrid, GlobalMajorant};
+pub use aabb::{Bounds3, DBounds3};
 pub use bounds::{BoundsLevel, CELL_LOG2, MAX_LEVELS};
 pub use convert::{convert, convert_tree, MAX_MAP_BRICKS};
-pub use dda::{ray_box, RaySegment, SegmentIter, TIGHT_ENOUGH};
+pub use dda::{SegmentIter, TIGHT_ENOUGH};
 pub use format::{read_cbrk, write_cbrk};
 pub use layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS};
 pub use partition::{Cell, CellPartition};
 pub use section::Section;
+pub use segment::MajorantSegment;
 pub use volume::{Atlas, BrickVolume, SourceInfo};
 
 /// Why a conversion or a `.cbrk` load failed.

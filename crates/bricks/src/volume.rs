@@ -106,8 +106,9 @@ impl BrickVolume {
         DMat4::from_translation(-self.origin.as_dvec3()) * self.index_to_world.inverse()
     }
 
+    /// How brick `b` is stored (empty outside the map).
     #[inline(always)]
-    pub(crate) fn brick_ref(&self, b: IVec3) -> BrickRef {
+    pub fn brick_ref(&self, b: IVec3) -> BrickRef {
         if b.x < 0
             || b.y < 0
             || b.z < 0

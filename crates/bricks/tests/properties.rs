@@ -1,7 +1,7 @@
 //! Property tests of conversion, lookups and the majorant walk against the
 //! reader's own tree (the independent reference).
 
-use cirrus_bricks::{convert_tree, BrickVolume, Cell, Precision, RaySegment, TIGHT_ENOUGH};
+use cirrus_bricks::{convert_tree, BrickVolume, Cell, MajorantSegment, Precision, TIGHT_ENOUGH};
 use cirrus_vdb::{Coord, Tree};
 use glam::{IVec3, Vec3};
 use proptest::prelude::*;
@@ -98,7 +98,7 @@ fn check_ray(
     // differ by over 2 density x voxels), and one that goes voxel by voxel.
     for (split, voxel_split) in [(0.0, f32::INFINITY), (2.0, f32::INFINITY), (0.0, 0.0)] {
         let cells = vol.partition(split, voxel_split);
-        let segs: Vec<RaySegment> = vol.segments_in(&cells, lo, d, t_min, t_max).collect();
+        let segs: Vec<MajorantSegment> = vol.segments_in(&cells, lo, d, t_min, t_max).collect();
         check_segments(tree, o, d, t_min, t_max, samples, &segs);
     }
 }
@@ -110,7 +110,7 @@ fn check_segments(
     t_min: f32,
     t_max: f32,
     samples: &[f32],
-    segs: &[RaySegment],
+    segs: &[MajorantSegment],
 ) {
     for w in segs.windows(2) {
         assert!(
@@ -366,8 +366,8 @@ fn cbrk_round_trip_is_bit_identical_and_corruption_is_an_error() {
 
 #[test]
 fn baselines_bound_the_density_too_and_the_hierarchy_is_tighter() {
+    use cirrus_bench::baseline::{FixedMajorantGrid, GlobalMajorant};
     use cirrus_bench::measure::{density_integral, measure, random_rays};
-    use cirrus_bricks::{FixedMajorantGrid, GlobalMajorant};
     let tree = random_tree(11, IVec3::ZERO);
     let vol = convert_tree(&tree, Precision::F32).unwrap();
     let global = GlobalMajorant::new(&vol);

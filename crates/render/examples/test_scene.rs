@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use cirrus_render::image_io::{write_exr, write_png};
+use cirrus_render::Bounds3;
 use cirrus_render::{
     render, Budget, Camera, Environment, GridField, IntegratorKind, Lights, Medium, RenderSettings,
     Scene, Sun,
@@ -56,13 +57,13 @@ fn main() -> std::io::Result<()> {
 }
 
 trait FramingBounds {
-    fn bounds_for_framing(&self) -> (Vec3, Vec3);
+    fn bounds_for_framing(&self) -> Bounds3;
 }
 
 impl FramingBounds for GridField {
-    fn bounds_for_framing(&self) -> (Vec3, Vec3) {
+    fn bounds_for_framing(&self) -> Bounds3 {
         let c = Vec3::splat(0.5);
         let blob = Vec3::new(0.45, 0.33, 0.45);
-        (c - blob, c + blob)
+        Bounds3::new(c - blob, c + blob)
     }
 }

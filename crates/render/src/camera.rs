@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 
+use crate::medium::Bounds3;
 use crate::ray::Ray;
 
 /// A pinhole camera at `from` looking at `to`; pixel `(0, 0)` is the top-left
@@ -45,15 +46,14 @@ impl Camera {
         }
     }
 
-    /// Frames the box `[lo, hi]` from a three-quarter view above and to the
+    /// Frames the box `bounds` from a three-quarter view above and to the
     /// side (azimuth 40 degrees, elevation 20 degrees, +Y up as in most VDB
     /// clouds), at the smallest distance from which all eight corners fall
     /// inside the frame, plus a 5% margin.
-    pub fn framing(bounds: (Vec3, Vec3), width: u32, height: u32) -> Self {
+    pub fn framing(bounds: Bounds3, width: u32, height: u32) -> Self {
         const VFOV: f32 = 35.0;
         const MARGIN: f32 = 1.05;
-        let (lo, hi) = bounds;
-        let centre = 0.5 * (lo + hi);
+        let centre = bounds.centre();
         let (az, el) = (40f32.to_radians(), 20f32.to_radians());
         let view = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
         let aspect = width.max(1) as f32 / height.max(1) as f32;
@@ -66,12 +66,7 @@ impl Camera {
         let right = forward.cross(Vec3::Y).normalize();
         let up = right.cross(forward);
         let mut distance = 1e-6f32;
-        for i in 0..8 {
-            let corner = Vec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            );
+        for corner in bounds.corners() {
             let c = corner - centre;
             let need = (c.dot(right).abs() / tan_h).max(c.dot(up).abs() / tan_v) + c.dot(view);
             distance = distance.max(need);

@@ -5,10 +5,12 @@
 //!
 //! - [`medium`] defines [`DensityField`], the one interface to a volume: point
 //!   lookups and, along a ray, front-to-back [`MajorantSegment`]s bounding
-//!   the density. The brick volumes implement it elsewhere; here live the test
-//!   fields ([`ConstantBox`], [`GridField`] with its DDA-walked
-//!   [`MajorantGrid`]) and the [`GlobalMajorant`] wrapper. A [`Medium`] adds
-//!   density scale, albedo and the [`HenyeyGreenstein`] phase function.
+//!   the density ([`MajorantSegment`] and the box type [`Bounds3`] are
+//!   `cirrus-bricks`' own). [`BrickField`] places a brick volume in render
+//!   space; with the `testing` feature the test fields live here too
+//!   (`ConstantBox`, `GridField` with its DDA-walked `MajorantGrid`). A
+//!   [`Medium`] adds density scale, albedo and a [`Phase`] function;
+//!   [`GlobalMedia`] puts one global majorant over any media (Mitsuba's way).
 //! - [`tracking`] turns segments into events: delta-tracked free flights and
 //!   ratio, residual-ratio and track-length transmittance, each with a
 //!   collision cap and Russian roulette.
@@ -63,9 +65,10 @@ pub use integrator::{
 };
 pub use light::{Environment, Lights, Sun};
 pub use medium::{
-    ConstantBox, DensityField, GlobalMajorant, GlobalMedia, GridField, Interaction, MajorantGrid,
-    MajorantSegment, Media, Medium,
+    Bounds3, BrickField, DensityField, GlobalMedia, Interaction, MajorantSegment, Media, Medium,
 };
+#[cfg(feature = "testing")]
+pub use medium::{ConstantBox, GridField, MajorantGrid};
 pub use phase::{HenyeyGreenstein, Phase};
 pub use ray::Ray;
 pub use render::{render, render_media, Rendered, Window};

@@ -3,7 +3,7 @@
 
 mod common;
 
-use cirrus_render::ray::clip_to_box;
+use cirrus_render::Bounds3;
 use cirrus_render::{render, Camera, ConstantBox, IntegratorKind, Lights, Medium, Scene};
 use glam::Vec3;
 
@@ -24,7 +24,8 @@ fn footprint_transmittance(
                 x as f32 + (i as f32 + 0.5) / m as f32,
                 y as f32 + (j as f32 + 0.5) / m as f32,
             );
-            let d = clip_to_box(r.origin, r.dir, b.lo, b.hi, 0.0, f32::INFINITY)
+            let d = Bounds3::new(b.lo, b.hi)
+                .clip_ray(r.origin, r.dir, 0.0, f32::INFINITY)
                 .map_or(0.0, |(t0, t1)| t1 - t0);
             sum += (-(sigma as f64) * d as f64).exp();
         }
@@ -69,7 +70,9 @@ fn absorbing_box_matches_beer_lambert() {
     // and the midpoint rule converges; the others are skipped.
     let hits = |x: f32, y: f32| {
         let r = camera.ray(x, y);
-        clip_to_box(r.origin, r.dir, b.lo, b.hi, 0.0, f32::INFINITY).is_some_and(|(a, c)| c > a)
+        Bounds3::new(b.lo, b.hi)
+            .clip_ray(r.origin, r.dir, 0.0, f32::INFINITY)
+            .is_some_and(|(a, c)| c > a)
     };
     let mut tested = 0;
     let mut z_sum = 0f64;

@@ -6,7 +6,7 @@
 mod common;
 
 use cirrus_render::blackbody::blackbody_rgb;
-use cirrus_render::ray::clip_to_box;
+use cirrus_render::Bounds3;
 use cirrus_render::{
     render_media, Blackbody, Camera, ConstantBox, Emission, IntegratorKind, Lights, VolumeInstance,
     Volumes,
@@ -31,7 +31,8 @@ fn footprint_opacity(cam: &Camera, b: &ConstantBox, sigma: f32, x: u32, y: u32, 
                 x as f32 + (i as f32 + 0.5) / m as f32,
                 y as f32 + (j as f32 + 0.5) / m as f32,
             );
-            let d = clip_to_box(r.origin, r.dir, b.lo, b.hi, 0.0, f32::INFINITY)
+            let d = Bounds3::new(b.lo, b.hi)
+                .clip_ray(r.origin, r.dir, 0.0, f32::INFINITY)
                 .map_or(0.0, |(t0, t1)| t1 - t0);
             sum += 1.0 - (-(sigma as f64) * d as f64).exp();
         }

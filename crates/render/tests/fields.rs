@@ -1,9 +1,9 @@
-//! The test fields: GridField's DDA and bounds, ConstantBox, GlobalMajorant.
+//! The test fields: GridField's DDA and bounds, ConstantBox; GlobalMedia's one segment.
 
 mod common;
 
-use cirrus_render::ray::clip_to_box;
-use cirrus_render::{ConstantBox, DensityField, GlobalMajorant, MajorantSegment, Rng};
+use cirrus_render::Bounds3;
+use cirrus_render::{ConstantBox, DensityField, GlobalMedia, MajorantSegment, Media, Medium, Rng};
 use glam::Vec3;
 
 /// Relative slack for `minorant <= density <= majorant`: the trilinear lerp
@@ -49,12 +49,14 @@ fn test_rays(lo: Vec3, hi: Vec3, n: usize) -> Vec<(Vec3, Vec3, f32, f32)> {
 }
 
 fn check_segments<F: DensityField>(field: &F, contiguous: bool) {
-    let (lo, hi) = field.bounds();
+    let Bounds3 { min: lo, max: hi } = field.bounds();
     let mut rng = Rng::new(9, 0, 0);
     let mut checked_points = 0;
     for (o, d, t_min, t_max) in test_rays(lo, hi, 400) {
         let segs: Vec<MajorantSegment> = field.segments(o, d, t_min, t_max).collect();
-        let overlap = clip_to_box(o, d, lo, hi, t_min, t_max).filter(|(a, b)| b > a);
+        let overlap = Bounds3::new(lo, hi)
+            .clip_ray(o, d, t_min, t_max)
+            .filter(|(a, b)| b > a);
         let Some((enter, exit)) = overlap else {
             assert!(segs.is_empty(), "segments for a ray that misses");
             continue;
@@ -120,7 +122,7 @@ fn grid_field_interpolates_its_voxels() {
     let (a, b) = (f.density(p(8.0, 7.0, 9.0)), f.density(p(9.0, 7.0, 9.0)));
     assert!(a > 0.0 && b > 0.0);
     assert!((f.density(p(8.5, 7.0, 9.0)) - 0.5 * (a + b)).abs() <= 1e-6);
-    let (lo, hi) = f.bounds();
+    let Bounds3 { min: lo, max: hi } = f.bounds();
     assert_eq!(f.density(lo - 0.01), 0.0);
     assert_eq!(f.density(hi + 0.01), 0.0);
     assert_eq!(f.density(Vec3::NAN), 0.0);
@@ -145,16 +147,21 @@ fn constant_box_has_one_exact_segment() {
 }
 
 #[test]
-fn global_majorant_collapses_to_one_segment() {
+fn global_media_collapse_to_one_segment() {
     let f = common::cloud_field(4);
-    let g = GlobalMajorant::new(&f);
-    check_segments(&g, true);
-    let (lo, hi) = f.bounds();
+    let max = f.global_majorant();
+    let Bounds3 { min: lo, max: hi } = f.bounds();
+    let medium = Medium::new(f, 2.0, Vec3::ONE, 0.0);
+    let g = GlobalMedia::new(&medium);
     for (o, d, t_min, t_max) in test_rays(lo, hi, 100) {
-        let segs: Vec<_> = g.segments(o, d, t_min, t_max).collect();
-        assert!(segs.len() <= 1);
-        if let Some(s) = segs.first() {
-            assert_eq!((s.minorant, s.majorant), (0.0, f.global_majorant()));
+        let segs: Vec<_> = g.majorants(o, d, t_min, t_max).collect();
+        let overlap = Bounds3::new(lo, hi)
+            .clip_ray(o, d, t_min, t_max)
+            .filter(|(a, b)| b > a);
+        assert_eq!(segs.len(), usize::from(overlap.is_some()));
+        if let (Some(s), Some((t0, t1))) = (segs.first(), overlap) {
+            assert_eq!((s.t0, s.t1), (t0, t1));
+            assert_eq!((s.minorant, s.majorant), (0.0, 2.0 * max));
         }
     }
 }

@@ -21,7 +21,7 @@ struct Broken {
 impl DensityField for Broken {
     type Segments<'a> = std::vec::IntoIter<MajorantSegment>;
 
-    fn bounds(&self) -> (Vec3, Vec3) {
+    fn bounds(&self) -> cirrus_render::Bounds3 {
         self.inner.bounds()
     }
     fn density(&self, p: Vec3) -> f32 {

@@ -7,7 +7,8 @@ use cirrus_render::tracking::{
     ratio_tracking, residual_ratio_tracking, sample_free_flight, track_length_transmittance,
     transmittance, FreeFlight, TransmittanceEstimator,
 };
-use cirrus_render::{ConstantBox, Counters, DensityField, Medium, Ray, Rng};
+use cirrus_render::Bounds3;
+use cirrus_render::{ConstantBox, Counters, DensityField, GlobalMedia, Medium, Ray, Rng};
 use glam::Vec3;
 
 const ESTIMATORS: [TransmittanceEstimator; 3] = [
@@ -98,9 +99,8 @@ fn t_max_limits_the_estimate() {
 /// with the field; 20 000 steps over at most ~2 units of a field with
 /// 1/16-unit voxels: the error is far below the Monte Carlo tolerance.
 fn quadrature_transmittance<F: DensityField>(medium: &Medium<F>, ray: &Ray) -> f64 {
-    let (lo, hi) = medium.field.bounds();
-    let Some((t0, t1)) =
-        cirrus_render::ray::clip_to_box(ray.origin, ray.dir, lo, hi, 0.0, f32::INFINITY)
+    let Bounds3 { min: lo, max: hi } = medium.field.bounds();
+    let Some((t0, t1)) = Bounds3::new(lo, hi).clip_ray(ray.origin, ray.dir, 0.0, f32::INFINITY)
     else {
         return 1.0;
     };
@@ -115,10 +115,10 @@ fn quadrature_transmittance<F: DensityField>(medium: &Medium<F>, ray: &Ray) -> f
 #[test]
 fn estimators_match_quadrature_on_a_grid_field_with_both_majorant_modes() {
     let field = common::cloud_field(4);
-    let (lo, hi) = field.bounds();
+    let Bounds3 { min: lo, max: hi } = field.bounds();
     let centre = 0.5 * (lo + hi);
     let medium = Medium::new(field, 6.0, Vec3::ONE, 0.0);
-    let global = medium.with_global_majorant();
+    let global = GlobalMedia::new(&medium);
     let rays = [
         Ray::new(
             centre - Vec3::new(2.0, 0.3, 0.1),
@@ -188,13 +188,7 @@ fn track_length_and_ratio_agree_through_the_public_functions() {
     let medium = Medium::new(unit_box(1.0), 0.8, Vec3::ONE, 0.0);
     let mut c = Counters::default();
     let (a, se_a) = estimate(20_000, 6, |rng| {
-        ratio_tracking(
-            &medium.with_global_majorant(),
-            &chord_ray(),
-            9.0,
-            rng,
-            &mut c,
-        )
+        ratio_tracking(&GlobalMedia::new(&medium), &chord_ray(), 9.0, rng, &mut c)
     });
     let (b, se_b) = estimate(20_000, 7, |rng| {
         track_length_transmittance(&medium, &chord_ray(), 9.0, rng, &mut c)

@@ -18,15 +18,12 @@
 //! With `max_depth = 0` only visible volumes matter. The rule is tested on
 //! boxes (conservative: a box may be kept whose contents are not needed).
 
-use cirrus_render::ray::clip_to_box;
+use cirrus_bricks::{Bounds3, DBounds3};
 use cirrus_render::{Camera, Crop, Lights};
 use glam::{DVec3, Vec3};
 
-/// An axis-aligned world box.
-pub type WorldBox = (DVec3, DVec3);
-
 /// Whether `b` (render space) meets the frustum of pixels `crop` of `camera`.
-pub fn in_frustum(camera: &Camera, crop: Crop, b: (Vec3, Vec3)) -> bool {
+pub fn in_frustum(camera: &Camera, crop: Crop, b: Bounds3) -> bool {
     let (x0, y0, x1, y1) = (
         crop.x0 as f32,
         crop.y0 as f32,
@@ -49,14 +46,7 @@ pub fn in_frustum(camera: &Camera, crop: Crop, b: (Vec3, Vec3)) -> bool {
         if n.dot(centre) < 0.0 {
             n = -n;
         }
-        let all_outside = (0..8).all(|i| {
-            let p = Vec3::new(
-                if i & 1 == 0 { b.0.x } else { b.1.x },
-                if i & 2 == 0 { b.0.y } else { b.1.y },
-                if i & 4 == 0 { b.0.z } else { b.1.z },
-            );
-            n.dot(p - apex) < 0.0
-        });
+        let all_outside = b.corners().iter().all(|&p| n.dot(p - apex) < 0.0);
         if all_outside {
             return false;
         }
@@ -66,29 +56,23 @@ pub fn in_frustum(camera: &Camera, crop: Crop, b: (Vec3, Vec3)) -> bool {
 
 /// Whether box `b` meets box `a` swept from its place toward the sun
 /// (direction `to_sun`), widened by `tan_half` per unit of distance.
-pub fn in_sun_prism(a: WorldBox, b: WorldBox, to_sun: DVec3, tan_half: f64) -> bool {
-    let (ca, ha) = (0.5 * (a.0 + a.1), 0.5 * (a.1 - a.0));
-    let cb = 0.5 * (b.0 + b.1);
-    let spread = tan_half * ((cb - ca).length() + ha.length() + (0.5 * (b.1 - b.0)).length());
+pub fn in_sun_prism(a: DBounds3, b: DBounds3, to_sun: DVec3, tan_half: f64) -> bool {
+    let (ca, ha) = (a.centre(), 0.5 * a.size());
+    let cb = b.centre();
+    let spread = tan_half * ((cb - ca).length() + ha.length() + (0.5 * b.size()).length());
     // The moving box meets b iff its centre's ray meets b grown by a's half size.
-    let (lo, hi) = (b.0 - ha - spread, b.1 + ha + spread);
-    let rel = |p: DVec3| (p - ca).as_vec3();
-    clip_to_box(
-        Vec3::ZERO,
-        to_sun.as_vec3(),
-        rel(lo),
-        rel(hi),
-        0.0,
-        f32::INFINITY,
-    )
-    .is_some()
+    let grown = DBounds3::new(b.min - ha - spread, b.max + ha + spread);
+    grown
+        .relative_to(ca)
+        .clip_ray(Vec3::ZERO, to_sun.as_vec3(), 0.0, f32::INFINITY)
+        .is_some()
 }
 
 /// Which volumes to load; `visible[i]` says whether volume `i` meets the
 /// frustum. See the module doc for the rule.
 pub fn needed(
     visible: &[bool],
-    boxes: &[WorldBox],
+    boxes: &[DBounds3],
     lights: &Lights,
     any_emission: bool,
     max_depth: Option<u32>,
@@ -132,9 +116,9 @@ mod tests {
 
     #[test]
     fn sun_prism_reaches_along_the_sun_only() {
-        let a = (DVec3::splat(-1.0), DVec3::splat(1.0));
-        let above = (DVec3::new(-0.5, 10.0, -0.5), DVec3::new(0.5, 11.0, 0.5));
-        let beside = (DVec3::new(5.0, -1.0, -1.0), DVec3::new(6.0, 1.0, 1.0));
+        let a = DBounds3::new(DVec3::splat(-1.0), DVec3::splat(1.0));
+        let above = DBounds3::new(DVec3::new(-0.5, 10.0, -0.5), DVec3::new(0.5, 11.0, 0.5));
+        let beside = DBounds3::new(DVec3::new(5.0, -1.0, -1.0), DVec3::new(6.0, 1.0, 1.0));
         let up = DVec3::Y;
         assert!(in_sun_prism(a, above, up, 0.0));
         assert!(!in_sun_prism(a, beside, up, 0.0));
@@ -153,15 +137,15 @@ mod tests {
             x1: 32,
             y1: 32,
         };
-        let ahead = (Vec3::new(-1.0, -1.0, -11.0), Vec3::new(1.0, 1.0, -9.0));
-        let behind = (Vec3::new(-1.0, -1.0, 9.0), Vec3::new(1.0, 1.0, 11.0));
-        let aside = (Vec3::new(30.0, -1.0, -11.0), Vec3::new(32.0, 1.0, -9.0));
+        let ahead = Bounds3::new(Vec3::new(-1.0, -1.0, -11.0), Vec3::new(1.0, 1.0, -9.0));
+        let behind = Bounds3::new(Vec3::new(-1.0, -1.0, 9.0), Vec3::new(1.0, 1.0, 11.0));
+        let aside = Bounds3::new(Vec3::new(30.0, -1.0, -11.0), Vec3::new(32.0, 1.0, -9.0));
         assert!(in_frustum(&cam, full, ahead));
         assert!(!in_frustum(&cam, full, behind));
         assert!(!in_frustum(&cam, full, aside));
         // A crop of the left half does not see a box on the right.
         let left = Crop { x1: 16, ..full };
-        let right_box = (Vec3::new(2.0, -0.5, -11.0), Vec3::new(3.0, 0.5, -9.0));
+        let right_box = Bounds3::new(Vec3::new(2.0, -0.5, -11.0), Vec3::new(3.0, 0.5, -9.0));
         assert!(in_frustum(&cam, full, right_box));
         assert!(!in_frustum(&cam, left, right_box));
     }

@@ -5,13 +5,12 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use cirrus_bricks::BrickVolume;
+use cirrus_bricks::{BrickVolume, DBounds3};
 use cirrus_render::medium::BrickField;
 use cirrus_render::{Blackbody, DensityField, Phase, VolumeInstance};
 use cirrus_vdb::VolumeFile;
 use glam::{DMat4, DVec3, Vec3};
 
-use crate::cull::WorldBox;
 use crate::defaults as d;
 use crate::description::{ScaleSpec, VolumeSpec};
 use crate::error::{Error, Result};
@@ -26,7 +25,7 @@ pub struct Plan {
     emission: Option<usize>,
     object_to_world: DMat4,
     /// From the grid header, when the file says.
-    pub world_box: Option<WorldBox>,
+    pub world_box: Option<DBounds3>,
     density_scale: Option<f32>,
     albedo: Vec3,
     phase: Phase,
@@ -98,7 +97,7 @@ pub fn plan(v: &VolumeSpec, files: &mut Files) -> Result<Plan> {
             // Trilinear support reaches one voxel past the active box.
             let lo = DVec3::from_array(lo.map(f64::from)) - 1.0;
             let hi = DVec3::from_array(hi.map(f64::from)) + 1.0;
-            world_box_of(object_to_world * t.index_to_world_matrix(), lo, hi)
+            DBounds3::new(lo, hi).transformed(object_to_world * t.index_to_world_matrix())
         });
         (density, temperature, emission, world_box)
     };
@@ -150,21 +149,6 @@ pub fn phase_of(v: &VolumeSpec) -> Result<Phase> {
     phase.map_err(|e| Error::input(format!("{}: {e}", v.file.display())))
 }
 
-/// The world box of the local box `[lo, hi]` under `m`.
-fn world_box_of(m: DMat4, lo: DVec3, hi: DVec3) -> WorldBox {
-    let mut b = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for k in 0..8 {
-        let c = DVec3::new(
-            if k & 1 == 0 { lo.x } else { hi.x },
-            if k & 2 == 0 { lo.y } else { hi.y },
-            if k & 4 == 0 { lo.z } else { hi.z },
-        );
-        let p = m.transform_point3(c);
-        b = (b.0.min(p), b.1.max(p));
-    }
-    b
-}
-
 /// Open files and loaded grids, shared by the volumes that use them (two
 /// instances of one file read it once), with what reading them cost.
 #[derive(Default)]
@@ -199,10 +183,10 @@ impl Files {
     }
 
     /// The world box of a plan's density grid, loading it.
-    pub fn density_box(&mut self, p: &Plan) -> Result<WorldBox> {
+    pub fn density_box(&mut self, p: &Plan) -> Result<DBounds3> {
         let v = self.grid(&p.file, p.cbrk, p.density)?;
         let m = p.object_to_world * v.local_from_world().inverse();
-        Ok(world_box_of(m, DVec3::ZERO, v.local_extent().as_dvec3()))
+        Ok(DBounds3::new(DVec3::ZERO, v.local_extent().as_dvec3()).transformed(m))
     }
 
     pub fn load_grids(&mut self, p: &Plan) -> Result<()> {

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use cirrus_bricks::BrickVolume;
+use cirrus_bricks::{Bounds3, BrickVolume, DBounds3};
 use cirrus_render::medium::BrickField;
 use cirrus_render::{
     render, render_media, Camera, Crop, DensityField, Medium, RenderControl, RenderSettings,
@@ -28,7 +28,7 @@ use cirrus_render::{
 };
 use glam::{DMat4, DVec3, Vec3};
 
-use crate::cull::{in_frustum, needed, WorldBox};
+use crate::cull::{in_frustum, needed};
 use crate::defaults as d;
 use crate::description::{SceneDescription, VolumeSpec};
 use crate::error::{Error, Result};
@@ -232,7 +232,7 @@ impl LoneVolume {
 
 /// The camera of `s` in render space (world minus `centre`), framing
 /// `bounds` (render space) when no eye and target are given.
-fn camera(s: &SceneSettings, centre: DVec3, bounds: (Vec3, Vec3)) -> Camera {
+fn camera(s: &SceneSettings, centre: DVec3, bounds: Bounds3) -> Camera {
     let to_render = |p: DVec3| (p - centre).as_vec3();
     let (w, h) = s.res;
     match s.look_at {
@@ -255,21 +255,17 @@ fn render_file(
         .iter()
         .map(|v| plan(v, &mut files))
         .collect::<Result<Vec<_>>>()?;
-    let boxes: Vec<WorldBox> = plans
+    let boxes: Vec<DBounds3> = plans
         .iter()
         .map(|p| match p.world_box {
             Some(b) => Ok(b),
             None => files.density_box(p),
         })
         .collect::<Result<_>>()?;
-    let union = boxes.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
-    );
+    let union = boxes.iter().fold(DBounds3::EMPTY, |u, &b| u.union(b));
     // Render space: world minus the scene's centre, in f64.
-    let centre = 0.5 * (union.0 + union.1);
-    let render_box = |b: &WorldBox| ((b.0 - centre).as_vec3(), (b.1 - centre).as_vec3());
-    let camera = camera(settings, centre, render_box(&union));
+    let centre = union.centre();
+    let camera = camera(settings, centre, union.relative_to(centre));
     let (w, h) = settings.res;
     let window = crop.unwrap_or(Crop {
         x0: 0,
@@ -279,7 +275,7 @@ fn render_file(
     });
     let visible: Vec<bool> = boxes
         .iter()
-        .map(|b| in_frustum(&camera, window, render_box(b)))
+        .map(|b| in_frustum(&camera, window, b.relative_to(centre)))
         .collect();
     let any_emission = plans.iter().any(|p| p.emits());
     let keep = needed(

@@ -79,8 +79,9 @@ impl LightGrid {
         let voxel = medium.voxel_size();
         let cell = settings.cell_voxels.max(MIN_STEP_VOXELS) * voxel;
         let step = step_voxels.max(MIN_STEP_VOXELS) * voxel;
-        let (lo, hi) = medium.bounds();
-        let extent = (hi - lo).max(Vec3::ZERO);
+        let bounds = medium.bounds();
+        let lo = bounds.min;
+        let extent = bounds.size().max(Vec3::ZERO);
         let points = [0, 1, 2].map(|a| (extent[a] / cell).ceil() as usize + 1);
         let bricks = points.map(|n| n.div_ceil(BRICK));
         let mut grid = Self {

@@ -7,23 +7,18 @@
 //! coordinates of ordinary size. An affine map keeps the ray parameter, so
 //! the bricks' segments come back in the caller's `t`.
 
-use super::field::{DensityField, MajorantSegment};
-use cirrus_bricks::{
-    BrickVolume, CellPartition, FixedGridIter, FixedMajorantGrid, RaySegment, SegmentIter,
-};
+use super::field::{Bounds3, DensityField};
+use cirrus_bricks::{BrickVolume, CellPartition, DBounds3, SegmentIter};
 use glam::{DMat4, DVec3, Mat4, Vec3};
 
 /// A [`BrickVolume`] placed in render space.
 pub struct BrickField<'v> {
     volume: &'v BrickVolume,
-    /// A pbrt-v4-style fixed majorant grid used instead of the hierarchy,
-    /// for the benchmarks that compare the two.
-    fixed: Option<FixedMajorantGrid>,
     /// The cells the hierarchy walk visits, made for the refinement rule of
     /// [`BrickField::with_refinement`]; `None`: the finest cells.
     partition: Option<CellPartition>,
     local_from_render: Mat4,
-    bounds: (Vec3, Vec3),
+    bounds: Bounds3,
     voxel_size: f32,
     global_majorant: f32,
 }
@@ -36,29 +31,20 @@ impl<'v> BrickField<'v> {
         let world_from_local = object_to_world * volume.local_from_world().inverse();
         let render_from_local = DMat4::from_translation(-render_offset) * world_from_local;
         let local_from_render = render_from_local.inverse();
-        // Bounds: the eight corners of the brick grid, in render space.
-        let e = volume.local_extent().as_dvec3();
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for k in 0..8 {
-            let c = DVec3::new(
-                if k & 4 != 0 { e.x } else { 0.0 },
-                if k & 2 != 0 { e.y } else { 0.0 },
-                if k & 1 != 0 { e.z } else { 0.0 },
-            );
-            let p = render_from_local.transform_point3(c).as_vec3();
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
+        // Bounds: the brick grid's box in render space, rounded once.
+        let local = DBounds3::new(DVec3::ZERO, volume.local_extent().as_dvec3());
+        let bounds = local
+            .transformed(render_from_local)
+            .relative_to(DVec3::ZERO);
         let axes = render_from_local.to_cols_array_2d();
         let voxel_size = (0..3)
             .map(|i| DVec3::new(axes[i][0], axes[i][1], axes[i][2]).length())
             .fold(f64::INFINITY, f64::min) as f32;
         BrickField {
             volume,
-            fixed: None,
             partition: None,
             local_from_render: local_from_render.as_mat4(),
-            bounds: (lo, hi),
+            bounds,
             voxel_size,
             global_majorant: volume.max_density(),
         }
@@ -87,44 +73,23 @@ impl<'v> BrickField<'v> {
         self
     }
 
-    /// Walks a fixed `res^3` majorant grid over the volume (pbrt-v4's
-    /// `MajorantGrid`, 64^3 in its NanoVDB medium) instead of the hierarchy.
-    pub fn with_fixed_grid(mut self, res: i32) -> Self {
-        self.fixed = Some(FixedMajorantGrid::build(self.volume, res));
-        self
-    }
-}
-
-/// Segments of either majorant structure.
-pub enum BrickSegments<'a> {
-    Hierarchy(SegmentIter<'a>),
-    Fixed(FixedGridIter<'a>),
-}
-
-impl Iterator for BrickSegments<'_> {
-    type Item = MajorantSegment;
-    #[inline]
-    fn next(&mut self) -> Option<MajorantSegment> {
-        let s: RaySegment = match self {
-            BrickSegments::Hierarchy(it) => it.next()?,
-            BrickSegments::Fixed(it) => it.next()?,
-        };
-        Some(MajorantSegment {
-            t0: s.t0,
-            t1: s.t1,
-            minorant: s.minorant,
-            majorant: s.majorant,
-        })
+    /// A render-space ray in the volume's local index space (an affine
+    /// map, so the parameter `t` is the same in both).
+    pub fn local_ray(&self, origin: Vec3, dir: Vec3) -> (Vec3, Vec3) {
+        (
+            self.local_from_render.transform_point3(origin),
+            self.local_from_render.transform_vector3(dir),
+        )
     }
 }
 
 impl DensityField for BrickField<'_> {
     type Segments<'a>
-        = BrickSegments<'a>
+        = SegmentIter<'a>
     where
         Self: 'a;
 
-    fn bounds(&self) -> (Vec3, Vec3) {
+    fn bounds(&self) -> Bounds3 {
         self.bounds
     }
 
@@ -135,14 +100,10 @@ impl DensityField for BrickField<'_> {
     }
 
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
-        let o = self.local_from_render.transform_point3(origin);
-        let d = self.local_from_render.transform_vector3(dir);
-        match (&self.fixed, &self.partition) {
-            (None, Some(cells)) => {
-                BrickSegments::Hierarchy(self.volume.segments_in(cells, o, d, t_min, t_max))
-            }
-            (None, None) => BrickSegments::Hierarchy(self.volume.segments(o, d, t_min, t_max)),
-            (Some(grid), _) => BrickSegments::Fixed(grid.segments(o, d, t_min, t_max)),
+        let (o, d) = self.local_ray(origin, dir);
+        match &self.partition {
+            Some(cells) => self.volume.segments_in(cells, o, d, t_min, t_max),
+            None => self.volume.segments(o, d, t_min, t_max),
         }
     }
 

@@ -3,8 +3,7 @@
 
 use glam::Vec3;
 
-use super::field::{DensityField, MajorantSegment};
-use crate::ray::clip_to_box;
+use super::field::{Bounds3, DensityField, MajorantSegment};
 
 /// Constant density inside the axis-aligned box `[lo, hi]`, zero outside.
 #[derive(Clone, Copy, Debug)]
@@ -30,8 +29,8 @@ impl ConstantBox {
 impl DensityField for ConstantBox {
     type Segments<'a> = std::option::IntoIter<MajorantSegment>;
 
-    fn bounds(&self) -> (Vec3, Vec3) {
-        (self.lo, self.hi)
+    fn bounds(&self) -> Bounds3 {
+        Bounds3::new(self.lo, self.hi)
     }
 
     fn density(&self, p: Vec3) -> f32 {
@@ -45,7 +44,8 @@ impl DensityField for ConstantBox {
 
     /// One exact segment: the chord through the box.
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
-        clip_to_box(origin, dir, self.lo, self.hi, t_min, t_max)
+        self.bounds()
+            .clip_ray(origin, dir, t_min, t_max)
             .filter(|(t0, t1)| t1 > t0)
             .map(|(t0, t1)| MajorantSegment {
                 t0,

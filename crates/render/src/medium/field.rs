@@ -3,15 +3,7 @@
 
 use glam::Vec3;
 
-/// Over `[t0, t1]` along a ray the (unscaled) density lies within
-/// `[minorant, majorant]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MajorantSegment {
-    pub t0: f32,
-    pub t1: f32,
-    pub minorant: f32,
-    pub majorant: f32,
-}
+pub use cirrus_bricks::{Bounds3, MajorantSegment};
 
 /// A density field in render space (world space minus an offset chosen by the
 /// caller so coordinates stay small in `f32`).
@@ -25,7 +17,7 @@ pub trait DensityField: Send + Sync {
         Self: 'a;
 
     /// Render-space bounds of where density may be non-zero.
-    fn bounds(&self) -> (Vec3, Vec3);
+    fn bounds(&self) -> Bounds3;
 
     /// Trilinearly interpolated density at a render-space point (0 outside).
     fn density(&self, p: Vec3) -> f32;
@@ -42,15 +34,14 @@ pub trait DensityField: Send + Sync {
     fn voxel_size(&self) -> f32;
 }
 
-/// A borrowed field is a field, so wrappers such as
-/// [`GlobalMajorant`](super::GlobalMajorant) can borrow instead of own.
+/// A borrowed field is a field, so media can borrow a field instead of own it.
 impl<T: DensityField + ?Sized> DensityField for &T {
     type Segments<'a>
         = T::Segments<'a>
     where
         Self: 'a;
 
-    fn bounds(&self) -> (Vec3, Vec3) {
+    fn bounds(&self) -> Bounds3 {
         (**self).bounds()
     }
     fn density(&self, p: Vec3) -> f32 {

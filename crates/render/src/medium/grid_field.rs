@@ -4,9 +4,8 @@
 
 use glam::Vec3;
 
-use super::field::DensityField;
+use super::field::{Bounds3, DensityField};
 use super::majorant_grid::{DdaSegments, MajorantGrid};
-use crate::ray::clip_to_box;
 
 /// Dense voxels, OpenVDB conventions: voxel `(i, j, k)` is a sample at
 /// `origin + (i, j, k) * voxel_size`, values outside the array are 0, and
@@ -152,13 +151,13 @@ impl GridField {
 impl DensityField for GridField {
     type Segments<'a> = DdaSegments<'a>;
 
-    fn bounds(&self) -> (Vec3, Vec3) {
+    fn bounds(&self) -> Bounds3 {
         let n = Vec3::new(
             self.dims[0] as f32,
             self.dims[1] as f32,
             self.dims[2] as f32,
         );
-        (
+        Bounds3::new(
             self.origin - Vec3::splat(self.voxel_size),
             self.origin + n * self.voxel_size,
         )
@@ -190,8 +189,10 @@ impl DensityField for GridField {
     /// The DDA over the majorant grid, clipped to the field's bounds (the
     /// grid's last cells may reach past them).
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> DdaSegments<'_> {
-        let (lo, hi) = self.bounds();
-        let (t0, t1) = clip_to_box(origin, dir, lo, hi, t_min, t_max).unwrap_or((1.0, 0.0));
+        let (t0, t1) = self
+            .bounds()
+            .clip_ray(origin, dir, t_min, t_max)
+            .unwrap_or((1.0, 0.0));
         self.majorants.segments(origin, dir, t0, t1)
     }
 

@@ -4,8 +4,7 @@
 
 use glam::Vec3;
 
-use super::field::MajorantSegment;
-use crate::ray::clip_to_box;
+use super::field::{Bounds3, MajorantSegment};
 
 /// Per-cell `[min, max]` of the density over a box split into equal cubes.
 #[derive(Clone, Debug)]
@@ -78,7 +77,8 @@ impl MajorantGrid {
             t_end: 0.0,
             done: true,
         };
-        let Some((t0, t1)) = clip_to_box(origin, dir, self.lo, self.hi(), t_min, t_max) else {
+        let bounds = Bounds3::new(self.lo, self.hi());
+        let Some((t0, t1)) = bounds.clip_ray(origin, dir, t_min, t_max) else {
             return it;
         };
         if t1 <= t0 {

@@ -14,7 +14,7 @@
 
 use glam::Vec3;
 
-use super::field::{DensityField, MajorantSegment};
+use super::field::{Bounds3, DensityField, MajorantSegment};
 use super::Medium;
 use crate::phase::Phase;
 use crate::sampling::Rng;
@@ -49,7 +49,7 @@ pub trait Media: Send + Sync {
     fn sigma_t(&self, p: Vec3) -> f32;
 
     /// Render-space bounds of where extinction may be non-zero.
-    fn bounds(&self) -> (Vec3, Vec3);
+    fn bounds(&self) -> Bounds3;
 
     /// Smallest voxel size (ray-march steps are given in voxels).
     fn voxel_size(&self) -> f32;
@@ -122,7 +122,7 @@ impl<F: DensityField> Media for Medium<F> {
         self.density_scale * self.field.density(p)
     }
 
-    fn bounds(&self) -> (Vec3, Vec3) {
+    fn bounds(&self) -> Bounds3 {
         self.field.bounds()
     }
 
@@ -182,7 +182,7 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
     fn sigma_t(&self, p: Vec3) -> f32 {
         self.inner.sigma_t(p)
     }
-    fn bounds(&self) -> (Vec3, Vec3) {
+    fn bounds(&self) -> Bounds3 {
         self.inner.bounds()
     }
     fn voxel_size(&self) -> f32 {

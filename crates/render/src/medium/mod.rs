@@ -2,26 +2,32 @@
 //! it into extinction, scattering and a phase function.
 //!
 //! - `field` defines [`DensityField`], the interface the trackers walk.
-//! - `constant_box`, `grid_field` (+ `majorant_grid`) are the fields this
-//!   crate owns (tests and the fixed-grid baseline); `brick_field` adapts
-//!   the brick volumes of `cirrus-bricks`, placed in render space.
-//! - `global` collapses any field to one global majorant (Mitsuba-style).
+//! - `constant_box`, `grid_field` (+ `majorant_grid`) are test fields with
+//!   known answers (feature `testing`); `brick_field` adapts the brick
+//!   volumes of `cirrus-bricks`, placed in render space.
+//! - `global` is the one segment of a global majorant (Mitsuba-style),
+//!   which [`GlobalMedia`] puts over any media.
 //! - `media` defines [`Media`], what the trackers and integrators walk: a
 //!   lone [`Medium`] or several volume instances, in extinction units.
 
 mod brick_field;
+#[cfg(feature = "testing")]
 mod constant_box;
 mod field;
 mod global;
+#[cfg(feature = "testing")]
 mod grid_field;
+#[cfg(feature = "testing")]
 mod majorant_grid;
 mod media;
 
-pub use brick_field::{BrickField, BrickSegments};
+pub use brick_field::BrickField;
+#[cfg(feature = "testing")]
 pub use constant_box::ConstantBox;
-pub use field::{DensityField, MajorantSegment};
-pub use global::GlobalMajorant;
+pub use field::{Bounds3, DensityField, MajorantSegment};
+#[cfg(feature = "testing")]
 pub use grid_field::GridField;
+#[cfg(feature = "testing")]
 pub use majorant_grid::{DdaSegments, MajorantGrid};
 pub use media::{GlobalMedia, Interaction, Media, Scaled};
 
@@ -64,26 +70,5 @@ impl<F: DensityField> Medium<F> {
     #[inline]
     pub fn sigma_t(&self, p: Vec3) -> f32 {
         self.density_scale * self.field.density(p)
-    }
-
-    /// The same medium seen through the global majorant.
-    pub fn with_global_majorant(&self) -> Medium<GlobalMajorant<&F>> {
-        Medium {
-            field: GlobalMajorant::new(&self.field),
-            density_scale: self.density_scale,
-            albedo: self.albedo,
-            phase: self.phase.clone(),
-        }
-    }
-
-    /// A medium borrowing this one's field (so integrators are written once
-    /// for `Medium<&F>`-like views and owned media alike).
-    pub fn by_ref(&self) -> Medium<&F> {
-        Medium {
-            field: &self.field,
-            density_scale: self.density_scale,
-            albedo: self.albedo,
-            phase: self.phase.clone(),
-        }
     }
 }

@@ -47,9 +47,9 @@ pub fn sample_free_flight<M: Media>(
             Event::Enter(_) => {}
             Event::End => return FreeFlight::Escaped,
             Event::Capped => return FreeFlight::Capped,
-            Event::Collision { t, segment } => {
-                let xi = rng.uniform() * segment.sigma_maj;
-                if xi < segment.sigma_min || xi < lookup(medium, ray, t, segment.sigma_maj, c) {
+            Event::Collision { t, segment, .. } => {
+                let xi = rng.uniform() * segment.majorant;
+                if xi < segment.minorant || xi < lookup(medium, ray, t, segment.majorant, c) {
                     c.real_collisions += 1;
                     return FreeFlight::Collision { t };
                 }

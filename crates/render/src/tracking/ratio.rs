@@ -29,10 +29,10 @@ pub fn ratio_tracking<M: Media>(
             Event::Enter(_) => {}
             Event::End => return tr,
             Event::Capped => return 0.0,
-            Event::Collision { t, segment } => {
+            Event::Collision { t, segment, .. } => {
                 c.shadow_collisions += 1;
-                let sigma = lookup(medium, ray, t, segment.sigma_maj, c);
-                tr *= (1.0 - sigma / segment.sigma_maj).max(0.0);
+                let sigma = lookup(medium, ray, t, segment.majorant, c);
+                tr *= (1.0 - sigma / segment.majorant).max(0.0);
                 if !roulette(&mut tr, rng) {
                     return 0.0;
                 }

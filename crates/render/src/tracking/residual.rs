@@ -34,17 +34,17 @@ pub fn residual_ratio_tracking<M: Media>(
             Event::End => return tr,
             Event::Capped => return 0.0,
             Event::Enter(segment) => {
-                if segment.sigma_min > 0.0 {
-                    tr *= (-segment.sigma_min * (segment.t1 - segment.t0)).exp();
+                if segment.minorant > 0.0 {
+                    tr *= (-segment.minorant * (segment.t1 - segment.t0)).exp();
                     if !roulette(&mut tr, rng) {
                         return 0.0;
                     }
                 }
             }
-            Event::Collision { t, segment } => {
+            Event::Collision { t, segment, rate } => {
                 c.shadow_collisions += 1;
-                let sigma = lookup(medium, ray, t, segment.sigma_maj, c);
-                tr *= (1.0 - (sigma - segment.sigma_min) / segment.rate).max(0.0);
+                let sigma = lookup(medium, ray, t, segment.majorant, c);
+                tr *= (1.0 - (sigma - segment.minorant) / rate).max(0.0);
                 if !roulette(&mut tr, rng) {
                     return 0.0;
                 }

@@ -7,25 +7,20 @@ use crate::stats::Counters;
 
 use super::MAX_COLLISIONS;
 
-/// A majorant segment (extinction units) with the rate at which
-/// tentative collisions are placed on it.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Segment {
-    pub t0: f32,
-    pub t1: f32,
-    pub sigma_min: f32,
-    pub sigma_maj: f32,
-    /// `sigma_maj` for delta and ratio tracking, `sigma_maj - sigma_min`
-    /// for residual ratio tracking.
-    pub rate: f32,
-}
-
+/// Segments come in extinction units (`Media::majorants`): `minorant` and
+/// `majorant` bound `sigma_t`. The walk places tentative collisions on a
+/// segment at its `rate`: `majorant` for delta and ratio tracking,
+/// `majorant - minorant` for residual ratio tracking.
 pub(crate) enum Event {
     /// The walk entered a segment (residual tracking applies its control
     /// transmittance here).
-    Enter(Segment),
-    /// A tentative collision at `t` inside `segment`.
-    Collision { t: f32, segment: Segment },
+    Enter(MajorantSegment),
+    /// A tentative collision at `t` inside `segment`, placed at `rate`.
+    Collision {
+        t: f32,
+        segment: MajorantSegment,
+        rate: f32,
+    },
     /// No more segments: the ray left the medium.
     End,
     /// The per-call collision cap was hit (counted in `collision_cap_hits`).
@@ -41,7 +36,8 @@ pub(crate) enum Event {
 pub(crate) struct Walk<I> {
     segments: I,
     residual: bool,
-    current: Option<Segment>,
+    /// The segment being walked and its rate.
+    current: Option<(MajorantSegment, f32)>,
     t: f32,
     tau: f32,
     collisions: u32,
@@ -62,43 +58,35 @@ impl<I: Iterator<Item = MajorantSegment>> Walk<I> {
     #[inline]
     pub fn next(&mut self, rng: &mut Rng, c: &mut Counters) -> Event {
         loop {
-            let Some(seg) = self.current else {
+            let Some((seg, rate)) = self.current else {
                 let Some(s) = self.segments.next() else {
                     return Event::End;
                 };
                 c.dda_segments += 1;
-                // Segments come in extinction units (`Media::majorants`).
-                let (sigma_min, sigma_maj) = (s.minorant, s.majorant);
                 let rate = if self.residual {
-                    sigma_maj - sigma_min
+                    s.majorant - s.minorant
                 } else {
-                    sigma_maj
+                    s.majorant
                 };
-                let seg = Segment {
-                    t0: s.t0,
-                    t1: s.t1,
-                    sigma_min,
-                    sigma_maj,
-                    rate,
-                };
-                self.current = Some(seg);
+                self.current = Some((s, rate));
                 self.t = s.t0;
-                return Event::Enter(seg);
+                return Event::Enter(s);
             };
             // `rate > 0` is false for NaN too: such segments are skipped.
-            if seg.rate > 0.0 {
-                let depth = seg.rate * (seg.t1 - self.t);
+            if rate > 0.0 {
+                let depth = rate * (seg.t1 - self.t);
                 if self.tau < depth {
                     self.collisions += 1;
                     if self.collisions > MAX_COLLISIONS {
                         c.collision_cap_hits += 1;
                         return Event::Capped;
                     }
-                    self.t = (self.t + self.tau / seg.rate).min(seg.t1);
+                    self.t = (self.t + self.tau / rate).min(seg.t1);
                     self.tau = sample_exponential(rng.uniform());
                     return Event::Collision {
                         t: self.t,
                         segment: seg,
+                        rate,
                     };
                 }
                 self.tau -= depth;

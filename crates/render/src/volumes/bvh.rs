@@ -12,7 +12,7 @@ use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
 use obvhs::ray::Ray as BvhRay;
 use smallvec::SmallVec;
 
-use crate::ray::clip_to_box;
+use crate::medium::Bounds3;
 
 /// One instance a ray meets, over `[t0, t1]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,15 +27,15 @@ pub type Hits = SmallVec<[Hit; 8]>;
 
 /// Render-space boxes of the instances and the BVH over them.
 pub struct TopLevel {
-    bounds: Vec<(Vec3, Vec3)>,
+    bounds: Vec<Bounds3>,
     bvh: Bvh2,
 }
 
 impl TopLevel {
-    pub fn new(bounds: Vec<(Vec3, Vec3)>) -> Self {
+    pub fn new(bounds: Vec<Bounds3>) -> Self {
         let aabbs: Vec<Aabb> = bounds
             .iter()
-            .map(|&(lo, hi)| Aabb::new(Vec3A::from(lo), Vec3A::from(hi)))
+            .map(|b| Aabb::new(Vec3A::from(b.min), Vec3A::from(b.max)))
             .collect();
         let indices = (0..aabbs.len() as u32).collect();
         let bvh = if aabbs.is_empty() {
@@ -52,7 +52,7 @@ impl TopLevel {
         Self { bounds, bvh }
     }
 
-    pub fn bounds(&self, instance: usize) -> (Vec3, Vec3) {
+    pub fn bounds(&self, instance: usize) -> Bounds3 {
         self.bounds[instance]
     }
 
@@ -66,8 +66,8 @@ impl TopLevel {
         let ray = BvhRay::new(Vec3A::from(origin), Vec3A::from(dir), t_min, t_max);
         self.bvh.ray_traverse_anyhit(ray, |_, id| {
             let instance = self.bvh.primitive_indices[id];
-            let (lo, hi) = self.bounds[instance as usize];
-            if let Some((t0, t1)) = clip_to_box(origin, dir, lo, hi, t_min, t_max) {
+            let b = self.bounds[instance as usize];
+            if let Some((t0, t1)) = b.clip_ray(origin, dir, t_min, t_max) {
                 if t1 > t0 {
                     hits.push(Hit { instance, t0, t1 });
                 }
@@ -83,8 +83,8 @@ impl TopLevel {
         // A linear scan beats the tree for the few instances of a usual
         // scene; the tree takes over for crowds.
         if self.bounds.len() <= 8 {
-            for (i, &(lo, hi)) in self.bounds.iter().enumerate() {
-                if p.cmpge(lo).all() && p.cmple(hi).all() {
+            for (i, b) in self.bounds.iter().enumerate() {
+                if b.contains(p) {
                     f(i);
                 }
             }
@@ -94,8 +94,7 @@ impl TopLevel {
             let n = &bvh.nodes[node as usize];
             for k in n.first_index..n.first_index + n.prim_count {
                 let i = bvh.primitive_indices[k as usize] as usize;
-                let (lo, hi) = self.bounds[i];
-                if p.cmpge(lo).all() && p.cmple(hi).all() {
+                if self.bounds[i].contains(p) {
                     f(i);
                 }
             }

@@ -23,7 +23,7 @@ pub use merge::Merged;
 use glam::Vec3;
 
 use crate::blackbody::Blackbody;
-use crate::medium::{DensityField, Interaction, MajorantSegment, Media, Scaled};
+use crate::medium::{Bounds3, DensityField, Interaction, MajorantSegment, Media, Scaled};
 use crate::phase::Phase;
 use crate::sampling::Rng;
 use crate::stats::Counters;
@@ -41,10 +41,7 @@ impl<F: DensityField> Emission<F> {
     /// Emitted radiance `Le` at `p`.
     #[inline]
     pub fn radiance(&self, p: Vec3, c: &mut Counters) -> Vec3 {
-        let inside = |f: &F| {
-            let (lo, hi) = f.bounds();
-            p.cmpge(lo).all() && p.cmple(hi).all()
-        };
+        let inside = |f: &F| f.bounds().contains(p);
         let mut le = Vec3::ZERO;
         if let Some((field, bb)) = &self.temperature {
             if inside(field) {
@@ -107,7 +104,7 @@ impl<F: DensityField> VolumeInstance<F> {
 pub struct Volumes<F> {
     instances: Vec<VolumeInstance<F>>,
     top: TopLevel,
-    bounds: (Vec3, Vec3),
+    bounds: Bounds3,
     voxel_size: f32,
     max_sigma_t: f32,
     emits: bool,
@@ -115,11 +112,8 @@ pub struct Volumes<F> {
 
 impl<F: DensityField> Volumes<F> {
     pub fn new(instances: Vec<VolumeInstance<F>>) -> Self {
-        let boxes: Vec<(Vec3, Vec3)> = instances.iter().map(|i| i.density.bounds()).collect();
-        let bounds = boxes.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), &(a, b)| (lo.min(a), hi.max(b)),
-        );
+        let boxes: Vec<Bounds3> = instances.iter().map(|i| i.density.bounds()).collect();
+        let bounds = boxes.iter().fold(Bounds3::EMPTY, |u, &b| u.union(b));
         let voxel_size = instances
             .iter()
             .map(|i| i.density.voxel_size())
@@ -219,7 +213,7 @@ impl<F: DensityField> Media for Volumes<F> {
         sigma
     }
 
-    fn bounds(&self) -> (Vec3, Vec3) {
+    fn bounds(&self) -> Bounds3 {
         self.bounds
     }
 

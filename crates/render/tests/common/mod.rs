@@ -1,6 +1,7 @@
 //! Shared scenes and statistics for the integration tests.
 #![allow(dead_code)]
 
+use cirrus_render::Bounds3;
 use cirrus_render::{
     Budget, Camera, Environment, GridField, Image, IntegratorKind, Lights, Medium, RenderSettings,
     Scene, Sun,
@@ -55,10 +56,10 @@ where
 {
     // Frame the blob's core rather than the array's bounds, so the blob
     // fills the image.
-    let (lo, hi) = medium.field.bounds();
+    let Bounds3 { min: lo, max: hi } = medium.field.bounds();
     let centre = 0.5 * (lo + hi);
     let blob = Vec3::new(0.3, 0.22, 0.3);
-    let camera = Camera::framing((centre - blob, centre + blob), size, size);
+    let camera = Camera::framing(Bounds3::new(centre - blob, centre + blob), size, size);
     Scene {
         medium,
         camera,

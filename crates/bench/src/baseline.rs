@@ -8,8 +8,7 @@
 //!   and `DDAMajorantIterator` (its NanoVDB medium uses 64^3 cells, each the
 //!   max over the cell's box padded by one voxel for the trilinear filter).
 
-use crate::dda::{ray_box, RaySegment};
-use crate::volume::BrickVolume;
+use cirrus_bricks::{Bounds3, BrickVolume, MajorantSegment};
 use glam::{IVec3, Vec3};
 use rayon::prelude::*;
 
@@ -33,12 +32,12 @@ impl GlobalMajorant {
         dir: Vec3,
         t_min: f32,
         t_max: f32,
-    ) -> impl Iterator<Item = RaySegment> {
-        let (a, b) = ray_box(origin, dir.recip(), Vec3::ZERO, self.extent);
+    ) -> impl Iterator<Item = MajorantSegment> {
+        let (a, b) = Bounds3::new(Vec3::ZERO, self.extent).slab(origin, dir.recip());
         let (t0, t1) = (a.max(t_min), b.min(t_max));
         let majorant = self.majorant;
         (t0 < t1 && majorant > 0.0)
-            .then_some(RaySegment {
+            .then_some(MajorantSegment {
                 t0,
                 t1,
                 minorant: 0.0,
@@ -74,7 +73,7 @@ impl FixedMajorantGrid {
                     for by in lo.y.div_euclid(8)..=hi.y.div_euclid(8) {
                         for bz in lo.z.div_euclid(8)..=hi.z.div_euclid(8) {
                             if volume.brick_ref(IVec3::new(bx, by, bz))
-                                == crate::layout::BrickRef::Empty
+                                == cirrus_bricks::BrickRef::Empty
                             {
                                 continue;
                             }
@@ -106,7 +105,7 @@ impl FixedMajorantGrid {
     /// Segments cell by cell (Amanatides–Woo), empty cells left out.
     pub fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> FixedGridIter<'_> {
         let inv = dir.recip();
-        let (a, b) = ray_box(origin, inv, Vec3::ZERO, self.extent);
+        let (a, b) = Bounds3::new(Vec3::ZERO, self.extent).slab(origin, inv);
         let (t, t_end) = (a.max(t_min), b.min(t_max));
         let p = origin + dir * t.max(a);
         let cell = (p / self.cell)
@@ -152,8 +151,8 @@ pub struct FixedGridIter<'a> {
 }
 
 impl Iterator for FixedGridIter<'_> {
-    type Item = RaySegment;
-    fn next(&mut self) -> Option<RaySegment> {
+    type Item = MajorantSegment;
+    fn next(&mut self) -> Option<MajorantSegment> {
         let r = self.grid.res;
         while self.t < self.t_end
             && self.cell.cmpge(IVec3::ZERO).all()
@@ -173,7 +172,7 @@ impl Iterator for FixedGridIter<'_> {
             self.cell[axis] += self.step[axis];
             self.t_next[axis] += self.t_delta[axis];
             if m > 0.0 && t1 > t0 {
-                return Some(RaySegment {
+                return Some(MajorantSegment {
                     t0,
                     t1,
                     minorant: 0.0,
