@@ -65,6 +65,9 @@ pub struct RenderSpec {
     pub refine_optical_depth: Option<f32>,
     /// Denoise the image with Open Image Denoise, guided by the albedo AOV.
     pub denoise: Option<bool>,
+    /// A frame range, `"A-B"` or `"A-B:STEP"`, for paths holding a frame
+    /// pattern (`####`, `%04d`).
+    pub frames: Option<String>,
 }
 
 /// `--res`, `--camera-from`, `--camera-to`, `--camera-up`, `--fov`.
@@ -238,6 +241,21 @@ impl SceneDescription {
         }
         if let Some(map) = self.environment.as_mut().and_then(|e| e.map.as_mut()) {
             *map = dir.join(&*map);
+        }
+    }
+
+    /// Every input and output path with its frame pattern replaced by `frame`.
+    pub fn substitute_frame(&mut self, frame: i64) {
+        use crate::frames::substitute;
+        for v in &mut self.volumes {
+            v.file = substitute(&v.file, frame);
+        }
+        if let Some(map) = self.environment.as_mut().and_then(|e| e.map.as_mut()) {
+            *map = substitute(map, frame);
+        }
+        let o = &mut self.output;
+        for path in [&mut o.exr, &mut o.png, &mut o.stats].into_iter().flatten() {
+            *path = substitute(path, frame);
         }
     }
 

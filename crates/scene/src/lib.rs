@@ -14,6 +14,8 @@
 //!   matter, and renders through `cirrus-render`. [`LoneVolume`] is one
 //!   volume loaded whole, which the benchmarks render many times.
 //! - [`Outputs`] writes the EXR, PNG and statistics whole or not at all.
+//! - [`frames`] parses frame ranges and replaces frame patterns
+//!   (`cloud.####.vdb`) in a scene's paths ([`Scene::for_frame`]).
 //! - [`info::file_report`] is the report of `cirrus info --json`;
 //!   [`dense::read_dense`] reads a grid into a dense array.
 //! - Every failure is an [`Error`] whose kind says whether a file or the
@@ -38,6 +40,7 @@ pub mod description;
 mod error;
 #[cfg(feature = "clap")]
 mod flags;
+pub mod frames;
 pub mod grids;
 pub mod info;
 mod output;

@@ -161,6 +161,14 @@ impl Scene {
         LoneVolume::load(self)
     }
 
+    /// The scene of frame `frame`: every input and output path with its
+    /// frame pattern replaced (see [`frames`](crate::frames)).
+    pub fn for_frame(&self, frame: i64) -> Scene {
+        let mut scene = self.clone();
+        scene.description.substitute_frame(frame);
+        scene
+    }
+
     /// The volume files the scene names (after overrides).
     pub fn inputs(&self) -> Vec<PathBuf> {
         self.description

@@ -1,9 +1,14 @@
 //! `cirrus render FILE|SCENE.toml -o OUT.exr [flags]`: maps the flags onto
-//! the scene library, renders, writes the outputs and prints a summary.
+//! the scene library, renders, writes the outputs and prints a summary;
+//! with `--frames` (or a scene file's `[render] frames`), once per frame.
+
+use std::path::{Path, PathBuf};
 
 use super::CliResult;
 use cirrus_render::Rendered;
-use cirrus_scene::{OutputFlags, Scene, SceneFlags};
+use cirrus_scene::frames::{has_pattern, substitute, FrameRange};
+use cirrus_scene::{OutputFlags, Overrides, Scene, SceneFlags};
+use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -11,24 +16,71 @@ pub struct RenderArgs {
     pub scene: SceneFlags,
     #[command(flatten)]
     pub output: OutputFlags,
+    /// Render frames A-B[:STEP]: the frame number replaces `####` or
+    /// `%04d` in every input and output path (the file, the scene's
+    /// volumes and sky, -o, --png, --stats).
+    #[arg(long)]
+    pub frames: Option<String>,
+    /// Render frames whose EXR already exists (by default they are
+    /// skipped, so an interrupted sequence resumes where it stopped).
+    #[arg(long)]
+    pub overwrite: bool,
 }
 
 pub fn run(args: &RenderArgs) -> CliResult {
-    let mut scene = Scene::load(&args.scene.file)?;
     let mut overrides = args.scene.overrides();
     args.output.write_into(&mut overrides);
-    scene.apply(&overrides);
-    scene.progress_bar = true;
+    let file = &args.scene.file;
+    match frame_range(args)? {
+        None => {
+            let scene = load(file, &overrides, None)?;
+            render_one(&scene, true)?;
+            Ok(())
+        }
+        Some(range) => sequence(file, &overrides, range, args.overwrite),
+    }
+}
+
+/// `--frames`, else a scene file's `[render] frames`, else none.
+fn frame_range(args: &RenderArgs) -> Result<Option<FrameRange>, Box<dyn std::error::Error>> {
+    let file = &args.scene.file;
+    if let Some(s) = &args.frames {
+        return Ok(Some(FrameRange::parse(s)?));
+    }
+    if has_pattern(&file.to_string_lossy()) {
+        return Err(format!("{}: a frame pattern needs --frames A-B", file.display()).into());
+    }
+    let from_file = match file.extension().is_some_and(|e| e == "toml") {
+        true => Scene::load(file)?.description().render.frames.clone(),
+        false => None,
+    };
+    Ok(from_file
+        .map(|s| FrameRange::parse(&s).map_err(|e| format!("{}: [render] {e}", file.display())))
+        .transpose()?)
+}
+
+/// The scene of `file` with the flags applied, for one frame or none.
+fn load(file: &Path, overrides: &Overrides, frame: Option<i64>) -> cirrus_scene::Result<Scene> {
+    let path = frame.map_or_else(|| file.to_path_buf(), |f| substitute(file, f));
+    let mut scene = Scene::load(&path)?;
+    scene.apply(overrides);
+    Ok(match frame {
+        Some(f) => scene.for_frame(f),
+        None => scene,
+    })
+}
+
+/// Renders and writes one scene; `bar`: draw the render's own progress bar.
+fn render_one(scene: &Scene, bar: bool) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let outputs = scene.outputs();
     let Some(exr) = outputs.exr.clone() else {
         return Err(
-            if args.scene.file.extension().is_some_and(|e| e == "toml") {
-                "an output file is required: -o OUT.exr or [output] exr = \"...\"".into()
-            } else {
-                "an output file is required: -o OUT.exr".into()
-            },
+            "an output file is required: -o OUT.exr (or [output] exr = \"...\" in a scene file)"
+                .into(),
         );
     };
+    let mut scene = scene.clone();
+    scene.progress_bar = bar;
     let rendered = scene.render()?;
     if rendered.stats.volumes_culled > 0 {
         eprintln!(
@@ -38,10 +90,53 @@ pub fn run(args: &RenderArgs) -> CliResult {
     }
     outputs.write(&rendered)?;
     summary(&exr, &rendered);
+    Ok(exr)
+}
+
+/// Every frame of `range`: frames whose EXR exists are skipped unless
+/// `overwrite` (outputs are written whole or not at all, so an existing
+/// file is a finished frame); a frame that fails is reported by number and
+/// file and the others go on; the run fails if any frame did.
+fn sequence(file: &Path, overrides: &Overrides, range: FrameRange, overwrite: bool) -> CliResult {
+    let bar = ProgressBar::new(range.count());
+    bar.set_style(
+        ProgressStyle::with_template("[{elapsed_precise}] [{wide_bar}] {pos}/{len} frames {msg}")
+            .expect("valid template"),
+    );
+    let (mut rendered, mut skipped, mut failed) = (0u64, 0u64, 0u64);
+    for frame in range.frames() {
+        bar.set_message(format!("(frame {frame})"));
+        let result = load(file, overrides, Some(frame))
+            .map_err(|e| e.into())
+            .and_then(|scene| {
+                let done = scene.outputs().exr.filter(|p| p.exists() && !overwrite);
+                match done {
+                    Some(_) => Ok(false),
+                    None => bar.suspend(|| render_one(&scene, false)).map(|_| true),
+                }
+            });
+        match result {
+            Ok(true) => rendered += 1,
+            Ok(false) => skipped += 1,
+            Err(e) => {
+                failed += 1;
+                bar.suspend(|| eprintln!("cirrus: frame {frame}: {e}"));
+            }
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    eprintln!(
+        "{} frames: {rendered} rendered, {skipped} skipped, {failed} failed",
+        range.count()
+    );
+    if failed > 0 {
+        return Err(format!("{failed} of {} frames failed", range.count()).into());
+    }
     Ok(())
 }
 
-fn summary(exr: &std::path::Path, rendered: &Rendered) {
+fn summary(exr: &Path, rendered: &Rendered) {
     let s = &rendered.stats;
     eprintln!(
         "{}: {}x{} at {} spp in {:.2} s ({:.0} paths/s; {} real, {} null collisions; load {:.2} s)",
