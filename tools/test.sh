@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every test of the project, as CI runs them: the Rust workspace (the
 # denoiser's tests with the real Open Image Denoise library from PyPI's
-# pyoidn), the Python module, and the Dask farm driver.
+# pyoidn), the Python module, the Dask farm driver, and `cirrus preview`
+# in headless Chromium.
 # Needs: cargo, python3 (3.11+) with venv and pip, and the package indexes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,3 +13,4 @@ export CIRRUS_OIDN
 cargo test --workspace --release
 bash tools/test_python.sh "$python"
 bash tools/test_farm.sh target/venv/bin/python
+bash tools/browser_test.sh

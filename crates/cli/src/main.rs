@@ -30,6 +30,8 @@ enum Command {
     Render(Box<commands::render::RenderArgs>),
     /// Assemble crop tiles (`render --crop`) into one full-size EXR.
     Merge(commands::merge::MergeArgs),
+    /// Serve a live progressive render in the browser.
+    Preview(commands::preview::PreviewArgs),
     /// Benchmarks that print figures.
     #[command(subcommand)]
     Bench(cirrus_bench::BenchCommand),
@@ -43,6 +45,7 @@ fn main() -> ExitCode {
         Command::Bench(cmd) => cirrus_bench::run(&cmd),
         Command::Render(args) => commands::render::run(&args),
         Command::Merge(args) => commands::merge::run(&args),
+        Command::Preview(args) => commands::preview::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -214,8 +214,7 @@ impl LoneVolume {
     pub fn prepare(&self) -> Result<(cirrus_render::Scene<BrickField<'_>>, RenderSettings)> {
         let volume = &self.volume;
         let s = &self.settings;
-        let world_from_local = volume.local_from_world().inverse();
-        let centre = world_from_local.transform_point3(volume.local_extent().as_dvec3() * 0.5);
+        let centre = self.centre();
         let field = BrickField::new(volume, DMat4::IDENTITY, centre);
         let camera = camera(s, centre, field.bounds());
         let density_scale = self
@@ -235,6 +234,14 @@ impl LoneVolume {
         };
         scene.validate()?;
         Ok((scene, s.render.clone()))
+    }
+}
+
+impl LoneVolume {
+    /// The world position of render space's origin: the volume's centre.
+    pub fn centre(&self) -> DVec3 {
+        let world_from_local = self.volume.local_from_world().inverse();
+        world_from_local.transform_point3(self.volume.local_extent().as_dvec3() * 0.5)
     }
 }
 

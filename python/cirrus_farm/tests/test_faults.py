@@ -11,8 +11,9 @@ from pathlib import Path
 import pytest
 
 from cirrus_farm import render_job
-from cirrus_farm.worker_tasks import CirrusKilled, render_tile
+from cirrus_farm.worker_tasks import CirrusKilled, merge_tiles, render_tile
 from render_helpers import (
+    DATA,
     RENDER_FLAGS,
     assert_same_pixels,
     make_frame_inputs,
@@ -112,3 +113,31 @@ def test_render_tile_tells_errors_from_kills(tmp_path, cirrus_bin):
         render_tile(write_script(tmp_path / "dies", "kill -9 $$\n"), str(bad),
                     str(tmp_path / "o.exr"), [], None, reuse_existing=False)
     assert not (tmp_path / "o.exr").exists()
+
+
+def test_merge_retried_after_its_rename_finds_the_frame_done(tmp_path, cirrus_bin):
+    """Run in this process: a first merge attempt renamed the output and
+    deleted a tile, then its worker died; the retry must not fail the frame."""
+    source = str(tmp_path / "in.vdb")
+    (tmp_path / "in.vdb").write_bytes((DATA / "cloud.vdb").read_bytes())
+    tiles = [str(tmp_path / ".out.tile-0-0.exr"), str(tmp_path / ".out.tile-1-0.exr")]
+    rendered = [render_tile(cirrus_bin, source, path, RENDER_FLAGS, crop, reuse_existing=True)
+                for path, crop in zip(tiles, ["0,0,16,25", "16,0,33,25"])]
+    assert [r["status"] for r in rendered] == ["rendered", "rendered"]
+
+    output = tmp_path / "out.exr"
+    first = merge_tiles(cirrus_bin, str(output), tiles, rendered)
+    assert first["status"] == "merged"
+    assert not any(os.path.exists(p) for p in tiles)
+    reference = render_reference(cirrus_bin, source, tmp_path / "ref.exr")
+    assert_same_pixels(output, reference)
+
+    # The retry sees the output and the tiles gone: done, not "no such file".
+    before = output.stat().st_mtime_ns
+    assert merge_tiles(cirrus_bin, str(output), tiles, rendered)["status"] == "merged"
+    assert output.stat().st_mtime_ns == before
+    # Without the output, missing tiles are an error naming the tile.
+    output.unlink()
+    failed = merge_tiles(cirrus_bin, str(output), tiles, rendered)
+    assert failed["status"] == "failed" and ".out.tile-0-0.exr" in failed["error"]
+    assert not output.exists()

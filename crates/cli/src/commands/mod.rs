@@ -1,6 +1,7 @@
 pub mod convert;
 pub mod info;
 pub mod merge;
+pub mod preview;
 pub mod render;
 
 /// The error every subcommand returns: printed once by `main`.

@@ -124,6 +124,10 @@ def merge_tiles(
     for outcome in tile_outcomes:
         if outcome["status"] == "failed":
             return {"status": "failed", "error": outcome["error"], "host": host}
+    if os.path.exists(output_path) and not all(os.path.exists(p) for p in tile_paths):
+        # An earlier attempt renamed the output into place and began deleting
+        # the tiles before its worker died: the frame is done.
+        return {"status": "merged", "seconds": 0.0, "host": host}
     folder, name = os.path.split(output_path)
     partial = os.path.join(folder, f".{name}.merging-{os.getpid()}.exr")
     outcome = _run_cirrus([cirrus, "merge", partial, *tile_paths], threads, cwd)
