@@ -127,7 +127,14 @@ def parse_args(argv=None):
     ap.add_argument("--density-scale", type=float, default=None,
                     help="extinction per unit density in 1/world units (default 0.5 / voxel size)")
     ap.add_argument("--albedo", type=float, default=0.99)
-    ap.add_argument("--g", type=float, default=0.6)
+    ap.add_argument("--g", type=float, default=0.6, help="HG g (of the first lobe of hg2)")
+    ap.add_argument("--phase", choices=["hg", "hg2", "rayleigh"], default="hg",
+                    help="hg: Mitsuba's hg(g); hg2: blendphase of hg(g) and hg(g2), cirrus's two-lobe HG; "
+                         "rayleigh: Mitsuba's rayleigh")
+    ap.add_argument("--g2", type=float, default=-0.3, help="the second lobe of hg2")
+    ap.add_argument("--lobe-weight", type=float, default=0.8,
+                    help="weight of hg2's FIRST lobe, as cirrus's flag (Mitsuba's blendphase `weight` is the "
+                         "second phase's, so it gets 1 - this)")
     ap.add_argument("--max-depth", type=int, default=None,
                     help="real scattering events per path as cirrus counts them (0 = sky through the volume only, "
                          "1 = single scattering; default unlimited). Mitsuba gets max_depth = this + 1")
@@ -164,6 +171,8 @@ def parse_args(argv=None):
         ap.error("--time renders one progressive image: no --batches / --stderr-out")
     if args.max_depth is not None and args.max_depth < 0:
         ap.error("--max-depth must be >= 0")
+    if not (0.0 <= args.lobe_weight <= 1.0):
+        ap.error("--lobe-weight must be in [0, 1]")
     return args
 
 
@@ -196,6 +205,21 @@ def mitsuba_max_depth(cirrus_max_depth: int | None) -> int:
     path vertices including the camera segment's end (1 = emitters seen directly through
     the medium, 2 = single scattering)."""
     return -1 if cirrus_max_depth is None else cirrus_max_depth + 1
+
+
+def mitsuba_phase(args) -> dict:
+    """cirrus --phase as a Mitsuba phase plugin.  cirrus's hg2 is w1 HG(g) + (1 - w1) HG(g2) with
+    w1 = --lobe-weight; Mitsuba's blendphase is (1 - weight) phase_0 + weight phase_1, so
+    weight = 1 - w1 with phase_0 = hg(g), phase_1 = hg(g2)."""
+    if args.phase == "hg":
+        return {"type": "hg", "g": float(args.g)}
+    if args.phase == "hg2":
+        return {"type": "blendphase", "weight": 1.0 - float(args.lobe_weight),
+                "phase_0": {"type": "hg", "g": float(args.g)},
+                "phase_1": {"type": "hg", "g": float(args.g2)}}
+    if args.phase == "rayleigh":
+        return {"type": "rayleigh"}
+    raise SystemExit(f"unsupported --phase {args.phase!r}")
 
 
 def build_scene(mi, args, vol_path: str, hdr: dict, *, alpha_pass: bool, spp: int):
@@ -239,7 +263,7 @@ def build_scene(mi, args, vol_path: str, hdr: dict, *, alpha_pass: bool, spp: in
         "sigma_t": {"type": "gridvolume", "filename": vol_path, "use_grid_bbox": True},
         "scale": float(density_scale),
         "albedo": 0.0 if alpha_pass else float(args.albedo),
-        "phase": {"type": "hg", "g": float(args.g)},
+        "phase": mitsuba_phase(args),
         # Grey extinction: no per-channel free-flight reweighting needed.
         "has_spectral_extinction": False,
     }
@@ -393,6 +417,7 @@ def main(argv=None) -> int:
         "setup_seconds": setup_s,
         "total_seconds": total_s,
         "mitsuba_max_depth": mitsuba_max_depth(args.max_depth),
+        "phase": mitsuba_phase(args),
         "density_scale": density_scale,
         "vol": vol_path,
         "vol_bbox": [list(hdr["bbox_min"]), list(hdr["bbox_max"])],
