@@ -142,7 +142,7 @@ impl Scene {
         } else {
             let mut settings = self.settings()?;
             configure(&mut settings.render, settings.res)?;
-            render_file(&self.description, &settings, outputs.crop, start)?
+            render_file(&self.description, &settings, start)?
         };
         if control.as_ref().is_some_and(|c| c.is_cancelled()) {
             return Err(Error::cancelled());
@@ -261,7 +261,6 @@ fn camera(s: &SceneSettings, centre: DVec3, bounds: Bounds3) -> Camera {
 fn render_file(
     desc: &SceneDescription,
     settings: &SceneSettings,
-    crop: Option<Crop>,
     start: Instant,
 ) -> Result<Rendered> {
     let mut files = Files::default();
@@ -282,7 +281,7 @@ fn render_file(
     let centre = union.centre();
     let camera = camera(settings, centre, union.relative_to(centre));
     let (w, h) = settings.res;
-    let window = crop.unwrap_or(Crop {
+    let window = settings.render.crop.unwrap_or(Crop {
         x0: 0,
         y0: 0,
         x1: w,
