@@ -72,8 +72,9 @@ impl BoundsLevel {
     }
 }
 
-/// Builds the coarser levels above `level0`.
+/// Builds the coarser levels above `level0`, each in parallel over its x-planes.
 pub fn build_pyramid(level0: BoundsLevel) -> Vec<BoundsLevel> {
+    use rayon::prelude::*;
     let mut levels = vec![level0];
     while levels.len() < MAX_LEVELS {
         let below = levels.last().unwrap();
@@ -81,24 +82,29 @@ pub fn build_pyramid(level0: BoundsLevel) -> Vec<BoundsLevel> {
             break;
         }
         let dims = below.dims.map(|d| d.div_ceil(2));
-        let mut cells = vec![0f32; 2 * dims.iter().map(|&d| d as usize).product::<usize>()];
-        for x in 0..dims[0] as i32 {
-            for y in 0..dims[1] as i32 {
-                for z in 0..dims[2] as i32 {
-                    let (mut lo, mut hi) = (f32::INFINITY, 0f32);
-                    for k in 0..8 {
-                        let c = [2 * x + (k >> 2), 2 * y + ((k >> 1) & 1), 2 * z + (k & 1)];
-                        let (a, b) = below.get(c);
-                        lo = lo.min(a);
-                        hi = hi.max(b);
+        let plane = 2 * dims[1] as usize * dims[2] as usize;
+        let mut cells = vec![0f32; plane * dims[0] as usize];
+        if plane > 0 {
+            cells
+                .par_chunks_mut(plane)
+                .enumerate()
+                .for_each(|(x, out)| {
+                    let x = x as i32;
+                    for y in 0..dims[1] as i32 {
+                        for z in 0..dims[2] as i32 {
+                            let (mut lo, mut hi) = (f32::INFINITY, 0f32);
+                            for k in 0..8 {
+                                let c = [2 * x + (k >> 2), 2 * y + ((k >> 1) & 1), 2 * z + (k & 1)];
+                                let (a, b) = below.get(c);
+                                lo = lo.min(a);
+                                hi = hi.max(b);
+                            }
+                            let i = 2 * (y as usize * dims[2] as usize + z as usize);
+                            out[i] = lo;
+                            out[i + 1] = hi;
+                        }
                     }
-                    let i = 2
-                        * ((x as usize * dims[1] as usize + y as usize) * dims[2] as usize
-                            + z as usize);
-                    cells[i] = lo;
-                    cells[i + 1] = hi;
-                }
-            }
+                });
         }
         levels.push(BoundsLevel {
             dims,

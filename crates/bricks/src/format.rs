@@ -49,9 +49,11 @@ fn err(path: &Path, msg: impl Into<String>) -> BrickError {
 }
 
 /// Writes `volume` to `path`, whole or not at all (a temporary file in the
-/// same folder, renamed into place).
+/// same folder, renamed into place). The sections go to the file from
+/// where they lie, never copied into one buffer: writing a volume costs no
+/// memory beside it.
 pub fn write_cbrk(volume: &BrickVolume, path: &Path) -> Result<(), BrickError> {
-    let bytes = encode(volume);
+    let (header, sections) = encode(volume);
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -63,9 +65,15 @@ pub fn write_cbrk(volume: &BrickVolume, path: &Path) -> Result<(), BrickError> {
     ));
     let io = |e: std::io::Error| err(path, e.to_string());
     let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(&bytes)?;
-        f.sync_all()?;
+        let mut f = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&tmp)?);
+        f.write_all(&header)?;
+        let mut at = HEADER;
+        for (s, offset) in &sections {
+            f.write_all(&vec![0u8; offset - at])?;
+            f.write_all(s)?;
+            at = offset + s.len();
+        }
+        f.into_inner().map_err(|e| e.into_error())?.sync_all()?;
         std::fs::rename(&tmp, path)
     })();
     if result.is_err() {
@@ -74,7 +82,8 @@ pub fn write_cbrk(volume: &BrickVolume, path: &Path) -> Result<(), BrickError> {
     result.map_err(io)
 }
 
-fn encode(v: &BrickVolume) -> Vec<u8> {
+/// The header (checksum included) and each section with its offset.
+fn encode(v: &BrickVolume) -> (Vec<u8>, Vec<(&[u8], usize)>) {
     let mut sections: Vec<&[u8]> = vec![
         v.info.grid_name.as_bytes(),
         bytemuck::cast_slice(&v.map),
@@ -133,14 +142,20 @@ fn encode(v: &BrickVolume) -> Vec<u8> {
         dims.iter().for_each(|x| h.extend(x.to_le_bytes()));
     }
     h.resize(HEADER, 0);
-    let mut out = vec![0u8; offset];
-    out[..HEADER].copy_from_slice(&h);
-    for (s, &at) in sections.iter().zip(&placed) {
-        out[at..at + s.len()].copy_from_slice(s);
+    // The checksum covers the file as written, padding included.
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&h);
+    let mut at = HEADER;
+    let mut placed: Vec<(&[u8], usize)> = sections.into_iter().zip(placed).collect();
+    // The file ends where the last (possibly empty) section would start.
+    placed.push((&[], offset));
+    for &(s, offset) in &placed {
+        crc.update(&vec![0u8; offset - at]);
+        crc.update(s);
+        at = offset + s.len();
     }
-    let crc = crc32fast::hash(&out);
-    out[CRC_AT..CRC_AT + 4].copy_from_slice(&crc.to_le_bytes());
-    out
+    h[CRC_AT..CRC_AT + 4].copy_from_slice(&crc.finalize().to_le_bytes());
+    (h, placed)
 }
 
 /// Little-endian field reader over the header (bounds already checked).

@@ -1,8 +1,10 @@
 //! Sparse bricks of density with a hierarchy of majorants and minorants:
 //! what the renderer's trackers walk.
 //!
-//! The pipeline: [`convert`] turns a float grid's tree (from `cirrus-vdb`)
-//! into a [`BrickVolume`]: a dense map of 8^3 bricks (`layout.rs`: empty,
+//! The pipeline: [`convert_file`] streams a float grid from its file (or
+//! [`convert`] takes a grid's tree from `cirrus-vdb`) into a
+//! [`BrickVolume`], both through one builder (`build.rs`, `stream.rs`): a
+//! dense map of 8^3 bricks (`layout.rs`: empty,
 //! constant, or stored at f32, f16 or u8), a voxel atlas, and a pyramid of
 //! (min, max) bounds per brick and per coarser cell (`bounds.rs`) that bound
 //! the trilinearly interpolated density. [`SegmentIter`] (`dda.rs`) walks a
@@ -15,6 +17,7 @@
 
 mod aabb;
 mod bounds;
+mod build;
 mod convert;
 mod dda;
 mod format;
@@ -22,6 +25,7 @@ mod layout;
 mod partition;
 mod section;
 mod segment;
+mod stream;
 mod volume;
 
 pub use aabb::{Bounds3, DBounds3};
@@ -33,6 +37,7 @@ pub use layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS};
 pub use partition::{Cell, CellPartition};
 pub use section::Section;
 pub use segment::MajorantSegment;
+pub use stream::{convert_file, RENDER_PRECISION};
 pub use volume::{Atlas, BrickVolume, SourceInfo};
 
 /// Why a conversion or a `.cbrk` load failed.
@@ -42,6 +47,9 @@ pub enum BrickError {
     Unsupported(String),
     #[error("too large: {0}")]
     TooLarge(String),
+    /// A stored brick's density exceeds f16's largest value.
+    #[error("density {0} does not fit in f16 (max 65504); use f32")]
+    F16Overflow(f32),
     #[error("{path}: {msg}")]
     File {
         path: std::path::PathBuf,

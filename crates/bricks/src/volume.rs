@@ -170,6 +170,77 @@ impl BrickVolume {
         }
     }
 
+    /// Decodes `out.len()` voxels of stored brick `b` from voxel `first`
+    /// on, `stride` apart.
+    fn stored_run(&self, b: u32, first: usize, stride: usize, out: &mut [f32]) {
+        let base = b as usize * 512 + first;
+        let at = |i: usize| base + i * stride;
+        match &self.atlas {
+            Atlas::F32(a) => out.iter_mut().enumerate().for_each(|(i, o)| *o = a[at(i)]),
+            Atlas::F16(a) if stride == 1 => {
+                use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
+                a[base..base + out.len()]
+                    .reinterpret_cast::<half::f16>()
+                    .convert_to_f32_slice(out);
+            }
+            Atlas::F16(a) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(i, o)| *o = half::f16::from_bits(a[at(i)]).to_f32()),
+            Atlas::U8(a) => {
+                let (lo, step) = (self.ranges[2 * b as usize], self.ranges[2 * b as usize + 1]);
+                out.iter_mut()
+                    .enumerate()
+                    .for_each(|(i, o)| *o = lo + a[at(i)] as f32 * step);
+            }
+        }
+    }
+
+    /// The 9^3 voxels from the first of brick `b` (the brick and the first
+    /// layer of its +x, +y, +z neighbours), x-major: what the bounds of its
+    /// cells read. Each neighbour's kind is looked up once and its voxels
+    /// decoded as runs.
+    pub(crate) fn gather_block(&self, b: IVec3, out: &mut [f32; 729]) {
+        const N: usize = 9;
+        let mut buf = [0f32; 512];
+        for k in 0..8usize {
+            let d = [k >> 2, (k >> 1) & 1, k & 1];
+            let r = d.map(|on| if on == 0 { 0..8usize } else { 8..9usize });
+            let n = r.iter().map(|r| r.len()).product::<usize>();
+            // The voxels this neighbour gives, in x-major order of its part.
+            let vals = &mut buf[..n];
+            match self.brick_ref(b + IVec3::new(d[0] as i32, d[1] as i32, d[2] as i32)) {
+                BrickRef::Empty => vals.fill(0.0),
+                BrickRef::Constant(c) => vals.fill(self.constants[c as usize]),
+                BrickRef::Stored(s) => match d {
+                    // The brick itself, a face, an edge or the corner of a neighbour:
+                    // (first voxel, stride) per run of the last varying axis.
+                    [0, 0, 0] => self.stored_run(s, 0, 1, vals),
+                    [1, 0, 0] => self.stored_run(s, 0, 1, vals), // x = 0: y, z
+                    [0, 1, 0] => {
+                        for x in 0..8 {
+                            self.stored_run(s, x << 6, 1, &mut vals[x * 8..x * 8 + 8]);
+                        }
+                    }
+                    [0, 0, 1] => self.stored_run(s, 0, 8, vals), // z = 0: x, y
+                    [1, 1, 0] => self.stored_run(s, 0, 1, vals), // x = y = 0: z
+                    [1, 0, 1] => self.stored_run(s, 0, 8, vals), // x = z = 0: y
+                    [0, 1, 1] => self.stored_run(s, 0, 64, vals), // y = z = 0: x
+                    _ => self.stored_run(s, 0, 1, vals),
+                },
+            }
+            let mut i = 0;
+            for x in r[0].clone() {
+                for y in r[1].clone() {
+                    let row = (x * N + y) * N;
+                    let len = r[2].len();
+                    out[row + r[2].start..row + r[2].end].copy_from_slice(&vals[i..i + len]);
+                    i += len;
+                }
+            }
+        }
+    }
+
     /// The voxel at local index `c` (0 outside the volume).
     #[inline]
     pub fn voxel(&self, c: IVec3) -> f32 {

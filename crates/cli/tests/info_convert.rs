@@ -27,7 +27,7 @@ fn info_json_agrees_with_the_manifest() {
             .iter()
             .find(|f| f["file"] == name)
             .unwrap();
-        let (ok, stdout, stderr) = cirrus(&["info", &format!("data/{name}"), "--json"]);
+        let (ok, stdout, stderr) = cirrus(&["info", &format!("data/{name}"), "--json", "--stats"]);
         assert!(ok, "{name}: {stderr}");
         let info: Value = serde_json::from_str(&stdout).unwrap();
         assert_eq!(info["format"], entry["format"], "{name}");

@@ -2,7 +2,9 @@
 
 use std::path::Path;
 
-use cirrus_bricks::{convert, read_cbrk, BrickVolume, Precision};
+use cirrus_bricks::{
+    convert_file, read_cbrk, BrickError, BrickVolume, Precision, RENDER_PRECISION,
+};
 use cirrus_vdb::{GridInfo, ValueType, VolumeFile};
 
 use crate::defaults::DENSITY_GRID;
@@ -35,11 +37,37 @@ pub fn choose_grid(file: &VolumeFile, name: Option<&str>) -> Result<usize> {
         })
 }
 
-/// Grid `index` of an open file as f32 bricks.
+/// Grid `index` of an open file as f32 bricks, streamed from the file
+/// (never into the reader's tree).
 pub fn read_bricks(file: &VolumeFile, index: usize) -> Result<BrickVolume> {
-    let grid = file.read_grid(index)?;
-    convert(&grid, Precision::F32)
-        .map_err(|e| Error::input(format!("{}: {e}", file.path().display())))
+    read_bricks_at(file, index, Precision::F32)
+}
+
+/// Grid `index` of an open file as bricks at `precision`, streamed.
+pub fn read_bricks_at(
+    file: &VolumeFile,
+    index: usize,
+    precision: Precision,
+) -> Result<BrickVolume> {
+    convert_file(file, index, precision).map_err(|e| brick_error(file, e))
+}
+
+/// Grid `index` as a render keeps it: [`RENDER_PRECISION`] (f16), or f32
+/// when its densities do not fit in f16.
+pub fn read_render_bricks(file: &VolumeFile, index: usize) -> Result<BrickVolume> {
+    match convert_file(file, index, RENDER_PRECISION) {
+        Err(BrickError::F16Overflow(_)) => convert_file(file, index, Precision::F32),
+        r => r,
+    }
+    .map_err(|e| brick_error(file, e))
+}
+
+/// The reader's errors name the file already; the converter's get its name.
+fn brick_error(file: &VolumeFile, e: BrickError) -> Error {
+    match e {
+        BrickError::Vdb(e) => e.into(),
+        e => Error::input(format!("{}: {e}", file.path().display())),
+    }
 }
 
 /// A `.cbrk` file, whole.
@@ -48,8 +76,10 @@ pub fn read_cbrk_file(path: &Path) -> Result<BrickVolume> {
     read_cbrk(path).map_err(|e| Error::file(e.to_string()))
 }
 
-/// The density volume of a `.vdb`/`.nvdb` (converted at f32) or a `.cbrk`,
-/// and the bytes read from disk for it (a `.cbrk` counts whole).
+/// The density volume of a `.vdb`/`.nvdb` (streamed into bricks at
+/// [`RENDER_PRECISION`], f16, see [`read_render_bricks`]) or a `.cbrk` (at
+/// the precision it was converted at), and the bytes read from disk for it
+/// (a `.cbrk` counts whole).
 pub fn load_volume(path: &Path, grid: Option<&str>) -> Result<(BrickVolume, u64)> {
     if is_cbrk(path) {
         let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
@@ -57,7 +87,7 @@ pub fn load_volume(path: &Path, grid: Option<&str>) -> Result<(BrickVolume, u64)
     }
     let f = VolumeFile::open(path)?;
     let index = choose_grid(&f, grid)?;
-    let volume = read_bricks(&f, index)?;
+    let volume = read_render_bricks(&f, index)?;
     Ok((volume, f.bytes_read()))
 }
 

@@ -65,6 +65,17 @@ fn main() {
             g.tree.active_bbox(),
         ));
     });
+    // The same figures streamed: topology, then leaf buffers decoded in
+    // parallel into a range per chunk, no tree (what `cirrus info --stats` does).
+    let streamed = best_of(|| {
+        let f = cirrus_vdb::VolumeFile::open(&path).unwrap();
+        let s = f.stream_grid::<f32>(index).unwrap();
+        let ranges = std::sync::Mutex::new(Vec::new());
+        s.decode_leaves(Range(f32::INFINITY, f32::NEG_INFINITY, &ranges))
+            .map_err(|_| ())
+            .unwrap();
+        std::hint::black_box(ranges.into_inner().unwrap());
+    });
     let vdb_print = best_of(|| {
         let out = Command::new("vdb_print")
             .arg("-l")
@@ -92,9 +103,38 @@ fn main() {
         "  cirrus load + stats         {ours_stats:.3} s  = {:.2} x vdb_print -l",
         ours_stats / vdb_print
     );
+    println!(
+        "  cirrus stream + stats       {streamed:.3} s  = {:.2} x vdb_print -l",
+        streamed / vdb_print
+    );
     println!("  vdb_print -l                {vdb_print:.3} s");
     println!(
         "  vdb-rs load + iterate       {vdb_rs:.3} s  -> cirrus is {:.2} x faster",
         vdb_rs / ours_stats
     );
+}
+
+/// Minimum and maximum of the active values of a run of leaves.
+struct Range<'a>(f32, f32, &'a std::sync::Mutex<Vec<(f32, f32)>>);
+
+impl cirrus_vdb::LeafSink<f32> for Range<'_> {
+    type Error = ();
+    fn split_front(&mut self, _: usize) -> Self {
+        Range(f32::INFINITY, f32::NEG_INFINITY, self.2)
+    }
+    fn leaf(
+        &mut self,
+        _: usize,
+        mask: &cirrus_vdb::BitMask<8>,
+        values: &[f32; 512],
+    ) -> Result<(), ()> {
+        for n in mask.iter_on() {
+            self.0 = self.0.min(values[n]);
+            self.1 = self.1.max(values[n]);
+        }
+        Ok(())
+    }
+    fn finish(self) {
+        self.2.lock().unwrap().push((self.0, self.1));
+    }
 }

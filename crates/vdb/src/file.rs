@@ -1,12 +1,14 @@
 //! Opening a volume file of either format, listing its grids, reading one.
 
-use crate::error::{Error, ErrorKind, Result};
-use crate::grid::{Grid, GridInfo};
+use crate::error::{unsupported, Error, ErrorKind, Result};
+use crate::grid::{Grid, GridClass, GridInfo};
 use crate::metadata::{meta_get, MetaMap, MetaValue};
 use crate::nanovdb::{self, NanoIndex};
+use crate::openvdb::stream::GridStream;
 use crate::openvdb::{self, Archive};
 use crate::source::FileSource;
 use crate::transform::Transform;
+use crate::value::{Value, ValueType};
 use std::path::Path;
 
 /// Which of the two formats a file is in.
@@ -32,6 +34,19 @@ enum Index {
 
 /// A grid's transform and inclusive index-space bounding box (min, max).
 pub type GridBounds = (Transform, [i32; 3], [i32; 3]);
+
+/// What a grid's record says before its tree: read without any voxel data.
+#[derive(Clone, Debug)]
+pub struct GridHeader {
+    /// The grid's metadata (OpenVDB writes `class`, `file_bbox_min`,
+    /// `file_bbox_max`, `file_voxel_count`, `file_mem_bytes`, ...).
+    pub metadata: MetaMap,
+    pub transform: Transform,
+    pub class: GridClass,
+    /// The background as up to three f64 components, for the value types
+    /// the reader knows.
+    pub background: Option<([f64; 3], usize)>,
+}
 
 /// An open volume file: its grid list is read, its grid data is not.
 pub struct VolumeFile {
@@ -156,6 +171,69 @@ impl VolumeFile {
         Ok(get("file_bbox_min")
             .zip(get("file_bbox_max"))
             .map(|(lo, hi)| (transform, lo, hi)))
+    }
+
+    /// Grid `index`'s metadata, transform, class and background, from its
+    /// first few hundred bytes (OpenVDB); `None` for NanoVDB, whose header
+    /// sits inside the (possibly compressed) grid buffer.
+    pub fn grid_header(&self, index: usize) -> Result<Option<GridHeader>> {
+        let err = |kind: ErrorKind| Error::new(self.path(), kind);
+        let count = self.grids().len();
+        if index >= count {
+            return Err(err(ErrorKind::NoSuchGrid(format!(
+                "#{index} (the file has {count})"
+            ))));
+        }
+        let Index::OpenVdb(a) = &self.index else {
+            return Ok(None);
+        };
+        type Header = (MetaMap, Transform, Option<([f64; 3], usize)>);
+        fn read<V: Value>(
+            a: &Archive,
+            src: &FileSource,
+            i: usize,
+        ) -> crate::error::KindResult<Header> {
+            let (m, t, bg) = a.header_and_background::<V>(src, i)?;
+            Ok((m, t, Some(bg.components())))
+        }
+        let src = &self.source;
+        let (metadata, transform, background) = match a.grids[index].info.value_type {
+            Some(ValueType::Float) => read::<f32>(a, src, index),
+            Some(ValueType::Double) => read::<f64>(a, src, index),
+            Some(ValueType::Int32) => read::<i32>(a, src, index),
+            Some(ValueType::Int64) => read::<i64>(a, src, index),
+            Some(ValueType::Bool | ValueType::Mask) => read::<bool>(a, src, index),
+            Some(ValueType::Vec3f) => read::<[f32; 3]>(a, src, index),
+            Some(ValueType::Vec3d) => read::<[f64; 3]>(a, src, index),
+            None => a.read_grid_header(src, index).map(|(m, t)| (m, t, None)),
+        }
+        .map_err(err)?;
+        let class = meta_get(&metadata, "class")
+            .and_then(|v| v.as_str())
+            .map_or(GridClass::Unknown, GridClass::from_name);
+        Ok(Some(GridHeader {
+            metadata,
+            transform,
+            class,
+            background,
+        }))
+    }
+
+    /// Starts streaming grid `index` of value type `V` (OpenVDB files, all
+    /// but bool and mask grids): reads its header and topology, not its
+    /// leaf values and not into a tree. See [`GridStream::decode_leaves`].
+    pub fn stream_grid<V: Value>(&self, index: usize) -> Result<GridStream<'_, V>> {
+        let err = |kind: ErrorKind| Error::new(self.path(), kind);
+        let count = self.grids().len();
+        if index >= count {
+            return Err(err(ErrorKind::NoSuchGrid(format!(
+                "#{index} (the file has {count})"
+            ))));
+        }
+        match &self.index {
+            Index::OpenVdb(a) => a.stream_grid(&self.source, index).map_err(err),
+            Index::NanoVdb(_) => Err(err(unsupported("streaming a NanoVDB grid"))),
+        }
     }
 
     /// Index of the first grid called `name`; the unique stored name

@@ -12,6 +12,13 @@
 //! - `nanovdb/` decodes NanoVDB file segments and grid buffers.
 //! - `tree/` is the shared tree, its accessor and statistics.
 //!
+//! [`VolumeFile::stream_grid`] reads an OpenVDB grid without building its
+//! tree: its topology first ([`Topology`]: tiles, leaf origins, counts,
+//! bounds), then [`GridStream::decode_leaves`] decodes the leaf buffers in
+//! parallel chunks into a [`LeafSink`] (the brick converter, statistics).
+//! [`VolumeFile::grid_header`] reads a grid's metadata, transform and
+//! background and nothing else.
+//!
 //! Every size read from a file is checked against the bytes that remain
 //! before it is used, and every failure is an [`Error`] naming the file.
 
@@ -31,10 +38,11 @@ mod value;
 
 pub use coord::{Coord, CoordBBox};
 pub use error::{Error, ErrorKind, Result};
-pub use file::{Format, GridBounds, VolumeFile};
+pub use file::{Format, GridBounds, GridHeader, VolumeFile};
 pub use grid::{Grid, GridClass, GridInfo, GridTree};
 pub use mask::BitMask;
 pub use metadata::{meta_get, MetaMap, MetaValue};
+pub use openvdb::stream::{ActiveTile, DecodeError, GridStream, LeafSink, Topology};
 pub use transform::{MapKind, Transform};
-pub use tree::{Accessor, Level, Tree};
+pub use tree::{Accessor, Level, NodeCounts, TileCounts, Tree, ValueRange};
 pub use value::{Value, ValueType};

@@ -51,6 +51,23 @@ impl MetaValue {
         }
     }
 
+    /// Whether [`MetaValue::decode`] reads values of this type (others
+    /// are kept as [`MetaValue::Other`], whatever their bytes).
+    pub fn decodes(type_name: &str) -> bool {
+        matches!(
+            type_name,
+            "string"
+                | "bool"
+                | "int32"
+                | "int64"
+                | "float"
+                | "double"
+                | "vec3i"
+                | "vec3s"
+                | "vec3d"
+        )
+    }
+
     pub fn as_str(&self) -> Option<&str> {
         match self {
             MetaValue::String(s) => Some(s),

@@ -1,7 +1,7 @@
 //! `cirrus convert IN [--grid NAME] [--precision f32|f16|u8] -o OUT.cbrk`.
 
 use super::CliResult;
-use cirrus_bricks::{convert, write_cbrk, Precision};
+use cirrus_bricks::{convert_file, write_cbrk, BrickError, Precision};
 use cirrus_scene::grids::choose_grid;
 use cirrus_vdb::VolumeFile;
 use std::path::PathBuf;
@@ -26,16 +26,19 @@ pub fn run(args: &ConvertArgs) -> CliResult {
     let precision = Precision::from_name(&args.precision).expect("clap checked the name");
     let file = VolumeFile::open(&args.input)?;
     let index = choose_grid(&file, args.grid.as_deref())?;
+    // Streamed: a .vdb grid goes into bricks without the reader's tree.
     let start = Instant::now();
-    let grid = file.read_grid(index)?;
-    let read_s = start.elapsed().as_secs_f64();
-    let start = Instant::now();
-    let volume = convert(&grid, precision).map_err(|e| format!("{}: {e}", args.input.display()))?;
+    let volume = convert_file(&file, index, precision).map_err(|e| match e {
+        BrickError::Vdb(e) => e.to_string(),
+        e => format!("{}: {e}", args.input.display()),
+    })?;
     let convert_s = start.elapsed().as_secs_f64();
+    let start = Instant::now();
     write_cbrk(&volume, &args.output)?;
+    let write_s = start.elapsed().as_secs_f64();
     let i = &volume.info;
     eprintln!(
-        "{}: grid {:?}, {} active voxels -> {} bricks stored, {} constant, {} empty ({} precision, max error {:e}); read {:.3} s, converted {:.3} s ({:.1} M active voxels/s), {} bytes",
+        "{}: grid {:?}, {} active voxels -> {} bricks stored, {} constant, {} empty ({} precision, max error {:e}); read and converted {:.3} s ({:.1} M active voxels/s), written {:.3} s, {} bytes",
         args.output.display(),
         i.grid_name,
         i.active_voxels,
@@ -44,9 +47,9 @@ pub fn run(args: &ConvertArgs) -> CliResult {
         i.bricks_empty,
         precision.name(),
         i.max_error,
-        read_s,
         convert_s,
         i.active_voxels as f64 / convert_s.max(1e-9) / 1e6,
+        write_s,
         volume.total_bytes()
     );
     if i.sanitized_voxels > 0 {

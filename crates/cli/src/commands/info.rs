@@ -1,7 +1,8 @@
-//! `cirrus info FILE [--json]`: the grids of a file, as a table or JSON.
+//! `cirrus info FILE [--json] [--stats]`: the grids of a file, as a table
+//! or JSON; from the headers alone unless `--stats` reads the voxels.
 
 use super::CliResult;
-use cirrus_scene::info::file_report;
+use cirrus_scene::info::file_report_with;
 use serde_json::Value as Json;
 use std::path::PathBuf;
 
@@ -12,10 +13,14 @@ pub struct InfoArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Read the voxels for the value range, NaN count, leaf and tile
+    /// counts and memory (without it: the headers alone, nothing decoded).
+    #[arg(long)]
+    pub stats: bool,
 }
 
 pub fn run(args: &InfoArgs) -> CliResult {
-    let report = file_report(&args.file)?;
+    let report = file_report_with(&args.file, args.stats)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else if report["format"] == "cbrk" {
@@ -45,6 +50,14 @@ fn print_table(r: &Json) {
             continue;
         }
         println!("{}", g["name"].as_str().unwrap_or(""));
+        // Fields only the data gives are null without --stats.
+        let or_stats = |v: String| {
+            if v.contains("null") {
+                "(--stats)".to_string()
+            } else {
+                v
+            }
+        };
         let rows = [
             (
                 "type",
@@ -62,18 +75,25 @@ fn print_table(r: &Json) {
             ("active voxels", g["active_voxels"].to_string()),
             (
                 "leaves / tiles",
-                format!("{} / {}", g["leaf_count"], g["tile_count"]),
+                or_stats(format!("{} / {}", g["leaf_count"], g["tile_count"])),
             ),
             ("index bbox", g["index_bbox"].to_string()),
             ("voxel size", g["voxel_size"].to_string()),
             ("transform", g["transform"].to_string()),
-            ("min / max", format!("{} / {}", g["min"], g["max"])),
+            (
+                "min / max",
+                or_stats(format!("{} / {}", g["min"], g["max"])),
+            ),
             (
                 "memory",
-                format!(
-                    "{} bytes in memory, {} in the file",
-                    g["memory_bytes"], g["file_bytes"]
-                ),
+                if g["memory_bytes"].is_null() {
+                    format!("{} bytes in the file", g["file_bytes"])
+                } else {
+                    format!(
+                        "{} bytes in memory, {} in the file",
+                        g["memory_bytes"], g["file_bytes"]
+                    )
+                },
             ),
         ];
         for (k, v) in rows {

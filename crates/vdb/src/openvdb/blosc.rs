@@ -60,19 +60,53 @@ pub fn decompress(src: &[u8], out: &mut [u8]) -> KindResult<()> {
     if blocksize == 0 {
         return Err(corrupt("blosc block size 0"));
     }
-    let compressor = (flags >> 5) & 0x7;
-    let nblocks = nbytes.div_ceil(blocksize);
-    let starts_end = HEADER + 4 * nblocks;
+    let starts_end = HEADER + 4 * nbytes.div_ceil(blocksize);
     if starts_end > src.len() {
         return Err(corrupt("blosc block table runs past the chunk"));
     }
     let shuffle = flags & FLAG_SHUFFLE != 0 && typesize > 1;
-    // Sized by nbytes, which the caller vouches for, never by the file's blocksize alone.
-    let mut scratch = if shuffle {
-        vec![0u8; blocksize.min(nbytes)]
-    } else {
-        Vec::new()
-    };
+    // Sized by nbytes, which the caller vouches for, never by the file's
+    // blocksize alone; kept per thread, as a leaf chunk is decoded per call.
+    thread_local! {
+        static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+    let mut scratch = SCRATCH.with(|s| std::mem::take(&mut *s.borrow_mut()));
+    if shuffle {
+        scratch.resize(blocksize.min(nbytes), 0);
+    }
+    let result = decode_blocks(
+        src,
+        out,
+        flags,
+        typesize,
+        nbytes,
+        blocksize,
+        compressor_of(flags),
+        shuffle,
+        &mut scratch,
+    );
+    SCRATCH.with(|s| *s.borrow_mut() = scratch);
+    result
+}
+
+fn compressor_of(flags: u8) -> u8 {
+    (flags >> 5) & 0x7
+}
+
+#[allow(clippy::too_many_arguments)]
+fn decode_blocks(
+    src: &[u8],
+    out: &mut [u8],
+    flags: u8,
+    typesize: usize,
+    nbytes: usize,
+    blocksize: usize,
+    compressor: u8,
+    shuffle: bool,
+    scratch: &mut [u8],
+) -> KindResult<()> {
+    let rd = |i: usize| u32::from_le_bytes(src[i..i + 4].try_into().unwrap()) as usize;
+    let nblocks = nbytes.div_ceil(blocksize);
     for b in 0..nblocks {
         let start = rd(HEADER + 4 * b);
         let bsize = blocksize.min(nbytes - b * blocksize);
@@ -156,6 +190,18 @@ fn decode_stream(compressor: u8, src: &[u8], dst: &mut [u8]) -> KindResult<()> {
 /// an element are stored as they are.
 fn unshuffle(typesize: usize, src: &[u8], dst: &mut [u8]) {
     let n = src.len() / typesize;
+    if typesize == 4 {
+        // The common case (f32 values): four streams zipped, without the
+        // inner loop's index arithmetic.
+        let (s0, rest) = src.split_at(n);
+        let (s1, rest) = rest.split_at(n);
+        let (s2, s3) = rest.split_at(n);
+        for (i, d) in dst[..4 * n].chunks_exact_mut(4).enumerate() {
+            d.copy_from_slice(&[s0[i], s1[i], s2[i], s3[i]]);
+        }
+        dst[4 * n..].copy_from_slice(&src[4 * n..]);
+        return;
+    }
     for i in 0..n {
         for j in 0..typesize {
             dst[i * typesize + j] = src[j * n + i];

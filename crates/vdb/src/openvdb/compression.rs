@@ -66,10 +66,16 @@ pub fn read_data(
         }
         return Ok(());
     }
-    let src = cur.take(
-        usize::try_from(size).unwrap_or(usize::MAX),
-        "compressed chunk",
-    )?;
+    // Neither zlib nor blosc (which stores a chunk it cannot shrink) grows
+    // data by more than a few bytes, so a larger size is corrupt: refused
+    // before anything is read or allocated for it.
+    let limit = nbytes as u64 + nbytes as u64 / 8 + 1024;
+    if size as u64 > limit {
+        return Err(corrupt(format!(
+            "compressed chunk of {size} bytes for {nbytes} bytes of values"
+        )));
+    }
+    let src = cur.take(size as usize, "compressed chunk")?;
     let Some(out) = out else { return Ok(()) };
     out.clear();
     out.resize(nbytes, 0);

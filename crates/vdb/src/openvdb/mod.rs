@@ -17,6 +17,7 @@
 
 pub(crate) mod blosc;
 mod compression;
+pub mod stream;
 mod tree_reader;
 
 use crate::bytes::ByteCursor;
@@ -115,25 +116,6 @@ impl Archive {
             metadata,
             grids,
         })
-    }
-
-    /// Reads only the start of grid `index`: its metadata and transform
-    /// (a few hundred bytes), not its tree. Lets a caller place a grid in
-    /// the world (`file_bbox_min` / `file_bbox_max` metadata, which OpenVDB
-    /// writes for every grid) before deciding to read it.
-    pub fn read_grid_header(
-        &self,
-        src: &FileSource,
-        index: usize,
-    ) -> KindResult<(MetaMap, Transform)> {
-        let entry = &self.grids[index];
-        let ((metadata, transform), _) = src.parse_at(entry.grid_pos, "grid header", |cur| {
-            let _compression = cur.u32("grid compression")?;
-            let metadata = read_meta_map(cur)?;
-            let transform = read_transform(cur)?;
-            Ok((metadata, transform))
-        })?;
-        Ok((metadata, transform))
     }
 
     /// Reads grid `index`: its metadata, transform and tree.

@@ -292,11 +292,31 @@ impl<V: Value> Tree<V> {
 
     /// Bytes this tree occupies in memory (nodes, tables and the root map).
     pub fn memory_bytes(&self) -> usize {
-        use std::mem::size_of;
-        let internal = |slots: usize, w: usize| 2 * 8 * w + slots * (4 + size_of::<V>()) + 12;
-        self.leaves.len() * (size_of::<LeafNode<V>>() + 512 * size_of::<V>())
-            + self.lower.len() * internal(4096, 64)
-            + self.upper.len() * internal(32768, 512)
-            + self.root.len() * (size_of::<RootEntry<V>>() + 16)
+        memory_bytes::<V>(NodeCounts {
+            root_entries: self.root.len() as u64,
+            upper: self.upper.len() as u64,
+            lower: self.lower.len() as u64,
+            leaves: self.leaves.len() as u64,
+        })
     }
+}
+
+/// How many nodes of each level a tree has (root entries: tiles and children).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NodeCounts {
+    pub root_entries: u64,
+    pub upper: u64,
+    pub lower: u64,
+    pub leaves: u64,
+}
+
+/// Bytes a [`Tree`] of value `V` with these node counts occupies in memory,
+/// without building it: what [`Tree::memory_bytes`] reports.
+pub fn memory_bytes<V: Value>(n: NodeCounts) -> usize {
+    use std::mem::size_of;
+    let internal = |slots: usize, w: usize| 2 * 8 * w + slots * (4 + size_of::<V>()) + 12;
+    n.leaves as usize * (size_of::<LeafNode<V>>() + 512 * size_of::<V>())
+        + n.lower as usize * internal(4096, 64)
+        + n.upper as usize * internal(32768, 512)
+        + n.root_entries as usize * (size_of::<RootEntry<V>>() + 16)
 }
