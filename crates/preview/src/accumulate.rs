@@ -54,14 +54,14 @@ impl Accumulation {
         if (img.width, img.height) != (self.width, self.height) || img.rgba.len() != n {
             return false;
         }
-        // Every pixel of a pass takes the pass's spp.
-        let taken = img.spp;
+        // A pass's pixels took `samples` each (fewer where adaptive
+        // sampling stopped them early).
         let aov_albedo = r.aovs.as_ref().map(|a| &a.albedo).filter(|a| a.len() == n);
         if aov_albedo.is_none() {
             self.albedo = None;
         }
         for i in 0..n {
-            let k = taken;
+            let k = img.samples.get(i).copied().unwrap_or(img.spp);
             if k == 0 {
                 continue;
             }
@@ -96,6 +96,7 @@ impl Accumulation {
             spp: self.spp,
             rgba: self.rgba.clone(),
             variance: vec![[0.0; 4]; self.rgba.len()],
+            samples: self.counts.clone(),
         }
     }
 }
@@ -113,6 +114,7 @@ mod tests {
                 spp,
                 rgba: vec![[value; 4]; 2],
                 variance: vec![[0.0; 4]; 2],
+                samples: vec![spp; 2],
             },
             stats: RenderStats::default(),
             window: Window {

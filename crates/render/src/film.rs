@@ -7,18 +7,21 @@ use crate::integrator::{AovSample, Sample};
 use crate::stats::Counters;
 
 /// A finished image (or its crop window, see [`Rendered`](crate::Rendered)):
-/// per-pixel mean RGBA (alpha = 1 - camera-ray transmittance) and the
-/// sample variance of each channel's estimator.
+/// per-pixel mean RGBA (alpha = 1 - camera-ray transmittance), the
+/// sample variance of each channel's estimator and the samples behind it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
     pub width: u32,
     pub height: u32,
-    /// Samples per pixel behind every pixel.
+    /// Samples per pixel: every pixel's count, or with adaptive sampling
+    /// the most any pixel took (`samples` has each pixel's).
     pub spp: u32,
     /// Row-major, top row first.
     pub rgba: Vec<[f32; 4]>,
     /// Unbiased sample variance of the per-sample values (0 with one spp).
     pub variance: Vec<[f32; 4]>,
+    /// Samples taken per pixel, row-major like `rgba`.
+    pub samples: Vec<u32>,
 }
 
 impl Image {
@@ -26,10 +29,12 @@ impl Image {
         self.rgba[(y * self.width + x) as usize]
     }
 
-    /// Standard error of each channel's mean: `sqrt(variance / spp)`.
+    /// Standard error of each channel's mean: `sqrt(variance / n)` for the
+    /// pixel's `n` samples.
     pub fn std_error(&self, x: u32, y: u32) -> [f32; 4] {
-        let v = self.variance[(y * self.width + x) as usize];
-        v.map(|v| (v / self.spp.max(1) as f32).sqrt())
+        let i = (y * self.width + x) as usize;
+        let n = self.samples[i].max(1) as f32;
+        self.variance[i].map(|v| (v / n).sqrt())
     }
 }
 
@@ -53,7 +58,18 @@ impl PixelAccumulator {
         }
     }
 
-    fn variance(&self) -> [f32; 4] {
+    /// Samples added so far.
+    #[inline]
+    pub(crate) fn count(&self) -> u32 {
+        self.n
+    }
+
+    #[inline]
+    pub(crate) fn mean(&self) -> [f32; 4] {
+        self.mean
+    }
+
+    pub(crate) fn variance(&self) -> [f32; 4] {
         if self.n < 2 {
             return [0.0; 4];
         }
@@ -113,6 +129,8 @@ pub(crate) struct Tile {
     pub w: u32,
     pub h: u32,
     pub pixels: Vec<PixelAccumulator>,
+    /// Pixels that adaptive sampling has stopped.
+    pub stopped: Vec<bool>,
     /// Empty unless the render keeps AOVs.
     pub aovs: Vec<AovAccumulator>,
 }
@@ -166,6 +184,7 @@ impl Film {
                     w,
                     h,
                     pixels: vec![PixelAccumulator::default(); n],
+                    stopped: vec![false; n],
                     aovs: if aovs {
                         vec![AovAccumulator::default(); n]
                     } else {
@@ -223,6 +242,7 @@ impl Film {
         let n = (self.width * self.height) as usize;
         let mut rgba = vec![[0.0; 4]; n];
         let mut variance = vec![[0.0; 4]; n];
+        let mut samples = vec![0; n];
         for tile in &self.tiles {
             for ty in 0..tile.h {
                 for tx in 0..tile.w {
@@ -236,6 +256,7 @@ impl Film {
                     }
                     rgba[i] = m;
                     variance[i] = acc.variance();
+                    samples[i] = acc.n;
                 }
             }
         }
@@ -245,6 +266,7 @@ impl Film {
             spp,
             rgba,
             variance,
+            samples,
         }
     }
 }

@@ -29,11 +29,15 @@
 //! - [`Camera`], [`light`] (sun and environment, constant or an
 //!   importance-sampled [`EnvMap`] over a [`distribution`]) and the counter-based
 //!   [`Rng`] in [`sampling`] are the supporting pieces. The RNG is keyed by
-//!   (seed, pixel, sample), which makes images independent of thread count.
+//!   (seed, pixel, sample), which makes images independent of thread count;
+//!   so are the Owen-scrambled Sobol points ([`sobol`]) a [`SampleStream`]
+//!   takes its first path vertices' draws from, and [`adaptive`] sampling
+//!   stops each pixel on its own samples.
 //!
 //! Coordinates are render space: world space minus an offset the caller
 //! picks so that f32 stays precise; lengths keep world units.
 
+pub mod adaptive;
 pub mod blackbody;
 pub mod camera;
 pub mod control;
@@ -50,10 +54,12 @@ pub mod ray;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod sobol;
 pub mod stats;
 pub mod tracking;
 pub mod volumes;
 
+pub use adaptive::Adaptive;
 pub use blackbody::Blackbody;
 pub use camera::Camera;
 pub use control::RenderControl;
@@ -72,7 +78,7 @@ pub use medium::{ConstantBox, GridField, MajorantGrid};
 pub use phase::{HenyeyGreenstein, Phase};
 pub use ray::Ray;
 pub use render::{render, render_media, Rendered, Window};
-pub use sampling::Rng;
+pub use sampling::{Rng, SampleStream, SamplerKind};
 pub use scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 pub use stats::{Counters, RenderStats};
 pub use tracking::TransmittanceEstimator;

@@ -7,15 +7,16 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
+use crate::adaptive::{Adaptive, Selection};
 use crate::camera::Camera;
 use crate::control::RenderControl;
-use crate::film::{AovImage, Film, Image};
+use crate::film::{AovImage, Film, Image, Tile};
 use crate::integrator::{
     CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
 };
 use crate::light::Lights;
 use crate::medium::{DensityField, GlobalMedia, Media};
-use crate::sampling::Rng;
+use crate::sampling::{Draw, SampleStream, SamplerKind};
 use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 use crate::stats::{Counters, RenderStats};
 
@@ -46,9 +47,12 @@ pub struct Window {
 /// Renders `scene` with `settings` on the ambient rayon pool (install a
 /// `ThreadPool` around the call to choose the thread count).
 ///
-/// Pixel `(x, y)`'s sample `s` draws all its random numbers from
-/// `Rng::new(seed, y * width + x, s)`, and each pixel accumulates its
-/// samples in order, so the image is bit-identical for any thread count.
+/// Pixel `(x, y)`'s sample `s` draws all its numbers from
+/// `SampleStream::new(sampler, seed, y * width + x, s)`, each pixel
+/// accumulates its samples in order, and adaptive sampling decides on the
+/// pixel's own samples alone, so the image is bit-identical for any
+/// thread count and a crop is bit-identical to the same pixels of the
+/// full image.
 pub fn render<F: DensityField>(scene: &Scene<F>, settings: &RenderSettings) -> Rendered {
     render_media(&scene.medium, &scene.camera, &scene.lights, settings)
 }
@@ -175,34 +179,41 @@ fn run<S: CameraSampler>(
         settings.aovs,
     );
     let progress = Progress::new(settings, film.width, film.height);
-    let mut spp = 0u32;
-    match settings.budget {
-        Budget::Spp(n) => {
-            *counters += pass(
-                &mut film,
-                sampler,
-                camera,
-                settings.seed,
-                0,
-                n.max(1),
-                &progress,
-            );
-            spp = n.max(1);
+    let passes = Passes {
+        sampler,
+        camera,
+        kind: settings.sampler,
+        seed: settings.seed,
+        progress: &progress,
+    };
+    let spp = match (settings.budget, settings.adaptive) {
+        (Budget::Spp(n), None) => {
+            let n = n.max(1);
+            *counters += passes.run(&mut film, Plan::Uniform { s0: 0, s1: n }).0;
+            n
         }
-        Budget::Time(seconds) => {
+        (Budget::Spp(n), Some(rule)) => {
+            let n = n.max(1);
+            let plan = Plan::Adaptive {
+                rule,
+                selection: None,
+                count: n,
+                max: n,
+            };
+            *counters += passes.run(&mut film, plan).0;
+            max_count(&film)
+        }
+        (Budget::Time(seconds), None) => {
             let budget = Duration::from_secs_f64(seconds.max(0.0));
             let loop_start = Instant::now();
+            let mut spp = 0u32;
             let mut size = 1u32;
             while size > 0 && !progress.cancelled() {
-                *counters += pass(
-                    &mut film,
-                    sampler,
-                    camera,
-                    settings.seed,
-                    spp,
-                    spp + size,
-                    &progress,
-                );
+                let plan = Plan::Uniform {
+                    s0: spp,
+                    s1: spp + size,
+                };
+                *counters += passes.run(&mut film, plan).0;
                 spp += size;
                 progress.set_spp(spp);
                 // Next pass: as many samples as the measured rate says fit in
@@ -213,50 +224,140 @@ fn run<S: CameraSampler>(
                 let fit = (remaining / per_spp.max(1e-9)).floor().min(u32::MAX as f64) as u32;
                 size = fit.min(size.saturating_mul(2));
             }
+            spp
         }
-    }
+        (Budget::Time(seconds), Some(rule)) => {
+            let budget = Duration::from_secs_f64(seconds.max(0.0));
+            let mut size = 1u32;
+            while size > 0 && !progress.cancelled() {
+                let pass_start = Instant::now();
+                let (selection, pixels) = Selection::next(&film, &rule);
+                if pixels == 0 {
+                    break; // every pixel is below the threshold
+                }
+                let plan = Plan::Adaptive {
+                    rule,
+                    selection: Some(selection),
+                    count: size,
+                    max: u32::MAX,
+                };
+                let (c, taken) = passes.run(&mut film, plan);
+                *counters += c;
+                progress.set_spp(max_count(&film));
+                // As the uniform loop, with the cost per sample of the last
+                // pass alone: passes move from cheap sky pixels to costly
+                // cloud pixels, so the running average would overshoot.
+                // The next pass takes `size` samples of about as many
+                // pixels as this one.
+                let per_sample = pass_start.elapsed().as_secs_f64() / taken.max(1) as f64;
+                let remaining = budget.saturating_sub(start.elapsed()).as_secs_f64();
+                let fit = remaining / (per_sample * pixels as f64).max(1e-9);
+                size = (fit.floor().min(u32::MAX as f64) as u32).min(size.saturating_mul(2));
+            }
+            max_count(&film)
+        }
+    };
     progress.finish();
     let image = film.resolve(spp, counters);
     (image, film.resolve_aovs())
 }
 
-/// One pass: samples `s0..s1` for every pixel, tiles in parallel.
-fn pass<S: CameraSampler>(
-    film: &mut Film,
-    sampler: &S,
-    camera: &Camera,
+/// The most samples any pixel of `film` has.
+fn max_count(film: &Film) -> u32 {
+    let counts = film.tiles.iter().flat_map(|t| t.pixels.iter());
+    counts.map(|p| p.count()).max().unwrap_or(0)
+}
+
+/// Which samples one pass takes of each pixel.
+#[derive(Clone, Copy)]
+enum Plan {
+    /// Samples `s0..s1` of every pixel.
+    Uniform { s0: u32, s1: u32 },
+    /// Up to `count` more samples of each pixel not stopped (and taken by
+    /// `selection`, if any), never beyond `max` in all; a pixel stops at
+    /// the first checkpoint where `rule` says it has converged.
+    Adaptive {
+        rule: Adaptive,
+        selection: Option<Selection>,
+        count: u32,
+        max: u32,
+    },
+}
+
+/// What every pass of one render shares.
+struct Passes<'a, S> {
+    sampler: &'a S,
+    camera: &'a Camera,
+    kind: SamplerKind,
     seed: u64,
-    s0: u32,
-    s1: u32,
-    progress: &Progress,
-) -> Counters {
-    // Random streams are keyed by the pixel's index in the full image, so
-    // a crop renders exactly the full render's values for its pixels.
-    let width = camera.width();
-    film.tiles
-        .par_iter_mut()
-        .map(|tile| {
-            let mut c = Counters::default();
-            if progress.cancelled() {
-                return c;
-            }
-            for ty in 0..tile.h {
-                for tx in 0..tile.w {
-                    let (x, y) = (tile.x0 + tx, tile.y0 + ty);
-                    let pixel = u64::from(y) * u64::from(width) + u64::from(x);
-                    for s in s0..s1 {
-                        let mut rng = Rng::new(seed, pixel, u64::from(s));
-                        let (u, v) = (rng.uniform(), rng.uniform());
-                        let ray = camera.ray(x as f32 + u, y as f32 + v);
-                        let sample = sampler.sample(ray, &mut rng, &mut c);
-                        tile.add(tx, ty, sample, &mut c);
+    progress: &'a Progress,
+}
+
+impl<S: CameraSampler> Passes<'_, S> {
+    /// One pass over the film, tiles in parallel; returns the work
+    /// counters and the number of samples taken.
+    fn run(&self, film: &mut Film, plan: Plan) -> (Counters, u64) {
+        film.tiles
+            .par_iter_mut()
+            .map(|tile| {
+                let mut c = Counters::default();
+                if self.progress.cancelled() {
+                    return (c, 0);
+                }
+                let mut taken = 0u64;
+                for ty in 0..tile.h {
+                    for tx in 0..tile.w {
+                        taken += self.pixel(tile, tx, ty, plan, &mut c);
                     }
                 }
+                let per_pixel = match plan {
+                    Plan::Uniform { s0, s1 } => s1 - s0,
+                    Plan::Adaptive { count, .. } => count,
+                };
+                self.progress
+                    .tile_done(u64::from(tile.w * tile.h) * u64::from(per_pixel));
+                (c, taken)
+            })
+            .reduce(|| (Counters::default(), 0), |a, b| (a.0 + b.0, a.1 + b.1))
+    }
+
+    /// The plan's samples of the tile's pixel `(tx, ty)`; returns how many.
+    fn pixel(&self, tile: &mut Tile, tx: u32, ty: u32, plan: Plan, c: &mut Counters) -> u64 {
+        let i = (ty * tile.w + tx) as usize;
+        let (s0, s1, rule) = match plan {
+            Plan::Uniform { s0, s1 } => (s0, s1, None),
+            Plan::Adaptive {
+                rule,
+                selection,
+                count,
+                max,
+            } => {
+                let (pixel, stopped) = (&tile.pixels[i], tile.stopped[i]);
+                if stopped || selection.is_some_and(|s| !s.takes(pixel, stopped)) {
+                    return 0;
+                }
+                // Samples are added in order, so the count is the next index.
+                let n = pixel.count();
+                (n, n.saturating_add(count).min(max), Some(rule))
             }
-            progress.tile_done(u64::from(tile.w * tile.h) * u64::from(s1 - s0));
-            c
-        })
-        .reduce(Counters::default, |a, b| a + b)
+        };
+        // Numbers are keyed by the pixel's index in the full image, so a
+        // crop renders exactly the full render's values for its pixels.
+        let (x, y) = (tile.x0 + tx, tile.y0 + ty);
+        let index = u64::from(y) * u64::from(self.camera.width()) + u64::from(x);
+        for s in s0..s1 {
+            let mut draws = SampleStream::new(self.kind, self.seed, index, s);
+            let (u, v) = draws.get_2d(Draw::PixelJitter, 0);
+            let ray = self.camera.ray(x as f32 + u, y as f32 + v);
+            let sample = self.sampler.sample_stream(ray, &mut draws, c);
+            tile.add(tx, ty, sample, c);
+            if rule.is_some_and(|r| r.is_checkpoint(s + 1) && r.converged(&tile.pixels[i])) {
+                tile.stopped[i] = true;
+                return u64::from(s + 1 - s0);
+            }
+        }
+        u64::from(s1 - s0)
+    }
 }
 
 /// A progress bar with ETA on stderr, or nothing when stderr is not a

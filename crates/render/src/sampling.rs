@@ -4,10 +4,51 @@
 //! of `(seed, stream, sample, n)`, with no state shared between pixels. A
 //! pixel's samples therefore do not depend on which thread renders them or in
 //! what order, which is what makes images bit-identical across thread counts.
+//!
+//! A camera sample draws through a [`SampleStream`]: with
+//! [`SamplerKind::Random`] every number comes from the [`Rng`]; with
+//! [`SamplerKind::Sobol`] (the default) the draws that matter most come from
+//! Owen-scrambled Sobol points ([`crate::sobol`]), keyed like the `Rng` by
+//! (seed, pixel index in the full image, sample index), so thread counts,
+//! crops and time budgets see the same numbers.
+//!
+//! ## Allocation of low-discrepancy draws
+//!
+//! Each [`Draw`] is its own shuffled, scrambled 1D or 2D point set (Burley
+//! 2020's padding), so a draw that is skipped (a light with no sample, a
+//! path ended early) shifts nothing else. Per camera sample:
+//!
+//! | draw | dims | where |
+//! |---|---|---|
+//! | pixel jitter | 2 | the camera ray's position in the pixel |
+//!
+//! then for each path vertex `b` (the `b`-th free flight and what follows
+//! its collision), while `b <` [`SOBOL_VERTICES`]:
+//!
+//! | draw | dims | where |
+//! |---|---|---|
+//! | free-flight distance | 1 | the first optical depth of the delta-tracking walk |
+//! | sun direction | 2 | next-event estimation of the sun |
+//! | sun shadow ray | 1 | the first optical depth of its transmittance walk |
+//! | sky direction | 2 | next-event estimation of the environment |
+//! | sky shadow ray | 1 | the first optical depth of its transmittance walk |
+//! | phase direction | 2 | the scattered direction |
+//! | Russian roulette | 1 | the path's survival |
+//!
+//! There is no light-selection draw: every scattering event samples each
+//! light. Everything else comes from the hashed [`Rng`]: draws made a
+//! variable number of times (null-collision decisions and the optical
+//! depths after the first, transmittance roulette, the instance picked
+//! among overlapping volumes) and every draw past the vertex budget, where
+//! the integrand's effective dimension is too high for stratification to
+//! pay.
 
 use std::f32::consts::PI;
 
 use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::sobol::{OwenSobol, SobolIndex};
 
 /// SplitMix64's output function (Steele, Lea, Flood 2014): a bijective
 /// 64-bit mixer whose outputs for consecutive inputs pass BigCrush.
@@ -22,10 +63,15 @@ const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// A counter-based generator: SplitMix64 whose starting state is a hash of
 /// `(seed, stream, sample)`, so the `n`-th draw is `mix64(key + n * GOLDEN)`.
+///
+/// One value can be queued ahead of the stream ([`Rng::queue`]): that is
+/// how a low-discrepancy number reaches the first draw of a tracker, whose
+/// later draws stay on the stream.
 #[derive(Clone, Debug)]
 pub struct Rng {
     key: u64,
     counter: u64,
+    queued: Option<f32>,
 }
 
 impl Rng {
@@ -34,7 +80,11 @@ impl Rng {
         let mut h = mix64(seed.wrapping_add(GOLDEN));
         h = mix64(h ^ stream.wrapping_mul(0xd6e8_feb8_6659_fd93));
         h = mix64(h ^ sample.wrapping_mul(0xa076_1d64_78bd_642f));
-        Self { key: h, counter: 0 }
+        Self {
+            key: h,
+            counter: 0,
+            queued: None,
+        }
     }
 
     #[inline]
@@ -43,16 +93,197 @@ impl Rng {
         mix64(self.key.wrapping_add(self.counter.wrapping_mul(GOLDEN)))
     }
 
-    /// Uniform in `[0, 1)`: the top 24 bits, so every value is exact in f32
-    /// and 1.0 is never returned.
+    /// Uniform in `[0, 1)`: the queued value if there is one, else the
+    /// stream's top 24 bits, so every value is exact in f32 and 1.0 is
+    /// never returned.
     #[inline]
     pub fn uniform(&mut self) -> f32 {
+        if let Some(u) = self.queued.take() {
+            return u;
+        }
         (self.next_u64() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+    }
+
+    /// Makes the next [`uniform`](Self::uniform) return `u` (in `[0, 1)`)
+    /// without advancing the stream.
+    #[inline]
+    pub fn queue(&mut self, u: f32) {
+        self.queued = Some(u);
+    }
+
+    /// Drops a queued value nobody drew.
+    #[inline]
+    pub fn clear_queue(&mut self) {
+        self.queued = None;
     }
 
     /// How many numbers this stream has produced (its dimension).
     pub fn dimension(&self) -> u64 {
         self.counter
+    }
+}
+
+/// Where a camera sample's numbers come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum SamplerKind {
+    /// Owen-scrambled Sobol points for the draws of the first path
+    /// vertices, the hashed stream for the rest.
+    #[default]
+    Sobol,
+    /// Every number from the hashed stream (independent samples).
+    Random,
+}
+
+impl SamplerKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sobol => "sobol",
+            Self::Random => "random",
+        }
+    }
+}
+
+/// Path vertices (free flights, counted from the camera's) whose draws
+/// come from Sobol points; later ones use the hashed stream.
+pub const SOBOL_VERTICES: u32 = 6;
+
+/// What a number is drawn for: its place in the allocation of the
+/// module documentation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Draw {
+    PixelJitter,
+    FreeFlight,
+    SunDirection,
+    SunShadow,
+    SkyDirection,
+    SkyShadow,
+    Phase,
+    Roulette,
+}
+
+impl Draw {
+    const PER_VERTEX: u32 = 7;
+
+    /// The point set this draw uses at path vertex `vertex`; `None` past
+    /// the vertex budget.
+    fn slot(self, vertex: u32) -> Option<u32> {
+        let k = match self {
+            Self::PixelJitter => return Some(0),
+            Self::FreeFlight => 0,
+            Self::SunDirection => 1,
+            Self::SunShadow => 2,
+            Self::SkyDirection => 3,
+            Self::SkyShadow => 4,
+            Self::Phase => 5,
+            Self::Roulette => 6,
+        };
+        (vertex < SOBOL_VERTICES).then(|| 1 + vertex * Self::PER_VERTEX + k)
+    }
+}
+
+/// Keeps the Sobol seeds apart from the `Rng` keys of the same pixel.
+const SOBOL_DOMAIN: u64 = 0x5e1b_0150_b01c_0de5;
+
+/// The numbers of one camera sample: the hashed [`Rng`] and, with the
+/// Sobol sampler, the pixel's key and the sample's index into its point
+/// sets. Nothing is allocated; the seeds of a draw's point set are hashed
+/// when it is drawn.
+#[derive(Clone, Debug)]
+pub struct SampleStream {
+    rng: Rng,
+    sobol: Option<SobolKey>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct SobolKey {
+    /// A hash of (seed, pixel index in the full image).
+    pixel: u64,
+    /// The sample index: the point taken from each set.
+    index: SobolIndex,
+}
+
+impl SampleStream {
+    /// Sample `sample` of pixel `pixel` (its index in the full image).
+    /// With [`SamplerKind::Random`] this is exactly `Rng::new(seed, pixel,
+    /// sample)`, drawn in the order the renderer always drew.
+    pub fn new(kind: SamplerKind, seed: u64, pixel: u64, sample: u32) -> Self {
+        let rng = Rng::new(seed, pixel, u64::from(sample));
+        let sobol = match kind {
+            SamplerKind::Random => None,
+            SamplerKind::Sobol => Some(SobolKey {
+                pixel: mix64(mix64(seed ^ SOBOL_DOMAIN) ^ pixel.wrapping_mul(GOLDEN)),
+                index: SobolIndex::new(sample),
+            }),
+        };
+        Self { rng, sobol }
+    }
+
+    /// A stream that draws everything from `rng`.
+    pub fn random(rng: Rng) -> Self {
+        Self { rng, sobol: None }
+    }
+
+    /// The hashed stream, for draws outside the allocation.
+    #[inline]
+    pub fn rng(&mut self) -> &mut Rng {
+        &mut self.rng
+    }
+
+    pub fn into_rng(self) -> Rng {
+        self.rng
+    }
+
+    /// The point set and index of `draw` at `vertex`, if it is a Sobol
+    /// draw. Its three seeds come from one 64-bit hash: its low and high
+    /// halves, and the high half of its product with an odd constant, which
+    /// depends on every bit of it.
+    #[inline]
+    fn points(&self, draw: Draw, vertex: u32) -> Option<(OwenSobol, SobolIndex)> {
+        let key = self.sobol?;
+        let slot = draw.slot(vertex)?;
+        let h = mix64(key.pixel ^ u64::from(slot + 1).wrapping_mul(GOLDEN));
+        let set = OwenSobol {
+            shuffle: h as u32,
+            scramble: [(h >> 32) as u32, (h.wrapping_mul(GOLDEN) >> 32) as u32],
+        };
+        Some((set, key.index))
+    }
+
+    /// One number in `[0, 1)` for `draw` at path vertex `vertex`.
+    #[inline]
+    pub fn get_1d(&mut self, draw: Draw, vertex: u32) -> f32 {
+        match self.points(draw, vertex) {
+            Some((set, i)) => set.get_1d(i),
+            None => self.rng.uniform(),
+        }
+    }
+
+    /// Two numbers in `[0, 1)` for `draw` at path vertex `vertex`.
+    #[inline]
+    pub fn get_2d(&mut self, draw: Draw, vertex: u32) -> (f32, f32) {
+        match self.points(draw, vertex) {
+            Some((set, i)) => set.get_2d(i),
+            None => {
+                let u = self.rng.uniform();
+                (u, self.rng.uniform())
+            }
+        }
+    }
+
+    /// Runs `f` (a tracker) on the hashed stream with `draw`'s number
+    /// queued as the first it draws, so only that first draw (the walk's
+    /// first optical depth) is stratified. A number `f` left undrawn is
+    /// dropped, never passed on.
+    #[inline]
+    pub fn leading<T>(&mut self, draw: Draw, vertex: u32, f: impl FnOnce(&mut Rng) -> T) -> T {
+        if let Some((set, i)) = self.points(draw, vertex) {
+            self.rng.queue(set.get_1d(i));
+        }
+        let out = f(&mut self.rng);
+        self.rng.clear_queue();
+        out
     }
 }
 

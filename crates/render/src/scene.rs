@@ -5,11 +5,13 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use crate::adaptive::Adaptive;
 use crate::camera::Camera;
 use crate::control::RenderControl;
 use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::light::Lights;
 use crate::medium::Medium;
+use crate::sampling::SamplerKind;
 use crate::tracking::TransmittanceEstimator;
 
 /// A volume, a camera and lights at infinity, all in render space.
@@ -43,11 +45,15 @@ impl MajorantMode {
 /// How long to render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Budget {
-    /// Exactly this many samples per pixel.
+    /// Exactly this many samples per pixel (at most, with adaptive
+    /// sampling).
     Spp(u32),
     /// Progressive passes until this many seconds of wall time (setup
     /// included) are spent; at least one sample per pixel is always taken
     /// and every pixel has the same count. The count reached is reported.
+    /// With adaptive sampling, each pass goes to the pixels of highest
+    /// error instead, and the render ends early once all are below the
+    /// threshold.
     Time(f64),
 }
 
@@ -60,6 +66,11 @@ pub struct RenderSettings {
     pub budget: Budget,
     /// Same seed, same image, whatever the thread count.
     pub seed: u64,
+    /// Where the path tracer's numbers come from (Sobol by default).
+    pub sampler: SamplerKind,
+    /// Per-pixel stopping on the pixel's own error; `None` gives every
+    /// pixel the whole budget.
+    pub adaptive: Option<Adaptive>,
     /// Scattering events per path (path tracer): 0 = environment through
     /// the volume only, 1 = single scattering, `None` = unlimited.
     pub max_depth: Option<u32>,
@@ -109,6 +120,8 @@ impl Default for RenderSettings {
             majorant: MajorantMode::Hierarchy,
             budget: Budget::Spp(16),
             seed: 0,
+            sampler: SamplerKind::Sobol,
+            adaptive: None,
             max_depth: None,
             step_voxels: 0.5,
             light_grid: LightGridSettings::default(),
@@ -145,6 +158,9 @@ impl RenderSettings {
         }
         if self.tile_size == 0 {
             return Err("tile size must be at least 1".into());
+        }
+        if let Some(a) = &self.adaptive {
+            a.validate()?;
         }
         Ok(())
     }

@@ -6,7 +6,7 @@
 //! lining at a fraction of the noise; density 1 is half a mean free path
 //! per voxel.
 
-use cirrus_render::{IntegratorKind, MajorantMode, TransmittanceEstimator};
+use cirrus_render::{IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
 
 pub const RES: (u32, u32) = (512, 512);
 pub const SPP: u32 = 64;
@@ -35,6 +35,9 @@ pub const DRAINE_ALPHA: f32 = 1.0;
 /// A typical cloud droplet, micrometres.
 pub const DROPLET_DIAMETER: f32 = 20.0;
 pub const INTEGRATOR: IntegratorKind = IntegratorKind::Path;
+pub const SAMPLER: SamplerKind = SamplerKind::Sobol;
+/// Samples a pixel takes before adaptive sampling may stop it.
+pub const MIN_SPP: u32 = 16;
 pub const TRANSMITTANCE: TransmittanceEstimator = TransmittanceEstimator::Residual;
 pub const MAJORANT: MajorantMode = MajorantMode::Hierarchy;
 /// Majorant cells are refined while crossing one would cost more than this

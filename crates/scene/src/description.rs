@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use cirrus_render::exr_layers::Aov;
-use cirrus_render::{IntegratorKind, MajorantMode, TransmittanceEstimator};
+use cirrus_render::{IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
@@ -55,6 +55,12 @@ pub struct RenderSpec {
     pub spp: Option<u32>,
     pub time: Option<f64>,
     pub seed: Option<u64>,
+    /// `"sobol"` or `"random"` (`--sampler`).
+    pub sampler: Option<SamplerKind>,
+    /// Relative error at which a pixel stops (`--noise-threshold`).
+    pub noise_threshold: Option<f32>,
+    /// Samples before a pixel may stop (`--min-spp`).
+    pub min_spp: Option<u32>,
     pub integrator: Option<IntegratorKind>,
     pub transmittance: Option<TransmittanceEstimator>,
     pub majorant: Option<MajorantMode>,

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use cirrus_render::exr_layers::Aov;
-use cirrus_render::{Crop, IntegratorKind, MajorantMode, TransmittanceEstimator};
+use cirrus_render::{Crop, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
 use glam::{DVec3, Vec3};
 
 use crate::overrides::Overrides;
@@ -40,6 +40,19 @@ pub struct SceneFlags {
     /// Same seed, same image, on any thread count [default: 0].
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Sample numbers: Owen-scrambled Sobol points for the first path
+    /// vertices, or independent random numbers [default: sobol].
+    #[arg(long, value_enum)]
+    pub sampler: Option<SamplerKind>,
+    /// Adaptive sampling: a pixel stops once the relative standard error
+    /// of its mean is below this (e.g. 0.02); with --time, passes go to the
+    /// pixels of highest error [default: off].
+    #[arg(long)]
+    pub noise_threshold: Option<f32>,
+    /// Samples every pixel takes before adaptive sampling may stop it
+    /// [default: 16].
+    #[arg(long)]
+    pub min_spp: Option<u32>,
     /// Camera position (world space) [default: framed on the volume].
     #[arg(long, value_parser = point, allow_hyphen_values = true, requires = "camera_to")]
     pub camera_from: Option<DVec3>,
@@ -172,6 +185,9 @@ impl SceneFlags {
             spp: self.spp,
             time: self.time,
             seed: self.seed,
+            sampler: self.sampler,
+            noise_threshold: self.noise_threshold,
+            min_spp: self.min_spp,
             integrator: self.integrator,
             transmittance: self.transmittance,
             majorant: self.majorant,

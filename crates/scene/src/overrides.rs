@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use cirrus_render::exr_layers::Aov;
-use cirrus_render::{Crop, IntegratorKind, MajorantMode, TransmittanceEstimator};
+use cirrus_render::{Crop, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
 use glam::{DVec3, Vec3};
 use serde::Deserialize;
 
@@ -31,6 +31,9 @@ pub struct Overrides {
     pub spp: Option<u32>,
     pub time: Option<f64>,
     pub seed: Option<u64>,
+    pub sampler: Option<SamplerKind>,
+    pub noise_threshold: Option<f32>,
+    pub min_spp: Option<u32>,
     pub integrator: Option<IntegratorKind>,
     pub transmittance: Option<TransmittanceEstimator>,
     pub majorant: Option<MajorantMode>,
@@ -107,6 +110,9 @@ impl Overrides {
             r.time = self.time;
         }
         set(&mut r.seed, self.seed);
+        set(&mut r.sampler, self.sampler);
+        set(&mut r.noise_threshold, self.noise_threshold);
+        set(&mut r.min_spp, self.min_spp);
         set(&mut r.integrator, self.integrator);
         set(&mut r.transmittance, self.transmittance);
         set(&mut r.majorant, self.majorant);

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use cirrus_render::{Budget, EnvMap, Environment, Lights, RenderSettings, Sun};
+use cirrus_render::{Adaptive, Budget, EnvMap, Environment, Lights, RenderSettings, Sun};
 use glam::{DVec3, Vec3};
 
 use crate::defaults as d;
@@ -53,6 +53,11 @@ impl SceneSettings {
             majorant: r.majorant.unwrap_or(d::MAJORANT),
             budget,
             seed: r.seed.unwrap_or(d::SEED),
+            sampler: r.sampler.unwrap_or(d::SAMPLER),
+            adaptive: r.noise_threshold.map(|threshold| Adaptive {
+                threshold,
+                min_spp: r.min_spp.unwrap_or(d::MIN_SPP),
+            }),
             max_depth: r.max_depth,
             step_voxels: r.step.unwrap_or(d::STEP),
             progress: false,

@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::light::Lights;
 use crate::ray::Ray;
-use crate::sampling::{power_heuristic, Rng};
+use crate::sampling::{power_heuristic, Rng, SampleStream};
 use crate::stats::Counters;
 
 /// Which integrator renders the image.
@@ -86,6 +86,13 @@ pub struct AovSample {
 /// share it across rayon's workers.
 pub trait CameraSampler: Sync {
     fn sample(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample;
+
+    /// [`sample`](Self::sample) drawing from a [`SampleStream`]: an
+    /// integrator that places low-discrepancy draws (the path tracer)
+    /// overrides it; the others take every number from the hashed stream.
+    fn sample_stream(&self, ray: Ray, stream: &mut SampleStream, c: &mut Counters) -> Sample {
+        self.sample(ray, stream.rng(), c)
+    }
 }
 
 /// Radiance reaching an escaping ray along `dir` from lights at infinity.

@@ -7,7 +7,7 @@ use crate::light::{LightSample, Lights};
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
-use crate::sampling::{power_heuristic, Rng};
+use crate::sampling::{power_heuristic, Draw, Rng, SampleStream};
 use crate::stats::Counters;
 use crate::tracking::{sample_free_flight, transmittance, FreeFlight, TransmittanceEstimator};
 
@@ -42,6 +42,10 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   chosen at the collision ([`Media::interaction`]).
 /// - Alpha is the track-length estimate of `1 - T` along the camera ray:
 ///   1 if its first free flight collides, else 0.
+/// - Numbers: each path vertex draws its free-flight distance, light
+///   directions, shadow rays' first optical depths, phase direction and
+///   roulette as the [`Draw`]s of [`crate::sampling`]'s allocation
+///   (Sobol points for the first vertices); the rest from the hashed stream.
 /// - Emission: at every real collision, with the instance chosen with
 ///   probability `sigma_t,i / sigma_t` ([`Media::interaction`]), the
 ///   path adds `beta * (1 - albedo_i) * Le_i`. Delta tracking samples the
@@ -72,28 +76,34 @@ impl<'a, M: Media> PathTracer<'a, M> {
         }
     }
 
-    /// NEE at `p` for a path arriving along `dir_in`.
+    /// NEE at `p`, path vertex `vertex`, for a path arriving along `dir_in`.
+    #[allow(clippy::too_many_arguments)]
     fn direct_light(
         &self,
         p: Vec3,
         dir_in: Vec3,
         phase: &Phase,
         mis: bool,
-        rng: &mut Rng,
+        vertex: u32,
+        draws: &mut SampleStream,
         c: &mut Counters,
     ) -> Vec3 {
         let mut l = Vec3::ZERO;
         if let Some(sun) = &self.lights.sun {
-            let s = sun.sample(rng.uniform(), rng.uniform());
+            let (u1, u2) = draws.get_2d(Draw::SunDirection, vertex);
+            let s = sun.sample(u1, u2);
             c.nee_rays_sun += 1;
-            l += self.light_term(p, dir_in, phase, s, mis, rng, c);
+            let shadow = (Draw::SunShadow, vertex);
+            l += self.light_term(p, dir_in, phase, s, mis, shadow, draws, c);
         }
         if let Some(env) = &self.lights.environment {
-            let s = env.sample(rng.uniform(), rng.uniform());
+            let (u1, u2) = draws.get_2d(Draw::SkyDirection, vertex);
+            let s = env.sample(u1, u2);
             c.env_samples += 1;
             // A zero-density sample (a pole) is dropped without a shadow ray.
             c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
-            l += self.light_term(p, dir_in, phase, s, mis, rng, c);
+            let shadow = (Draw::SkyShadow, vertex);
+            l += self.light_term(p, dir_in, phase, s, mis, shadow, draws, c);
         }
         l
     }
@@ -108,7 +118,8 @@ impl<'a, M: Media> PathTracer<'a, M> {
         phase: &Phase,
         s: LightSample,
         mis: bool,
-        rng: &mut Rng,
+        (draw, vertex): (Draw, u32),
+        draws: &mut SampleStream,
         c: &mut Counters,
     ) -> Vec3 {
         let f = phase.eval(dir_in, s.to_light);
@@ -126,13 +137,22 @@ impl<'a, M: Media> PathTracer<'a, M> {
             Some(_) => return Vec3::ZERO,
         };
         let shadow = Ray::new(p, s.to_light);
-        let tr = transmittance(self.estimator, self.medium, &shadow, f32::INFINITY, rng, c);
+        let tr = draws.leading(draw, vertex, |rng| {
+            transmittance(self.estimator, self.medium, &shadow, f32::INFINITY, rng, c)
+        });
         s.radiance * (weight * tr)
     }
 }
 
 impl<M: Media> CameraSampler for PathTracer<'_, M> {
     fn sample(&self, camera_ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
+        let mut draws = SampleStream::random(rng.clone());
+        let out = self.sample_stream(camera_ray, &mut draws, c);
+        *rng = draws.into_rng();
+        out
+    }
+
+    fn sample_stream(&self, camera_ray: Ray, draws: &mut SampleStream, c: &mut Counters) -> Sample {
         c.paths += 1;
         let emits = self.medium.emits();
         let mut ray = camera_ray;
@@ -147,7 +167,12 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
         // having had their full weight from next-event estimation.
         let mut emission_only = false;
         loop {
-            let flight = sample_free_flight(self.medium, &ray, f32::INFINITY, rng, c);
+            // This free flight and the events at its collision are path
+            // vertex `vertex` of the draw allocation.
+            let vertex = depth;
+            let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
+                sample_free_flight(self.medium, &ray, f32::INFINITY, rng, c)
+            });
             if depth == 0 && flight != FreeFlight::Escaped {
                 alpha = 1.0;
             }
@@ -165,7 +190,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 FreeFlight::Collision { t } => t,
             };
             let p = ray.at(t);
-            let it = self.medium.interaction(p, rng);
+            let it = self.medium.interaction(p, draws.rng());
             if depth == 0 {
                 aov.albedo = it.albedo;
                 aov.depth = Some(t);
@@ -184,7 +209,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 break;
             }
             let last = self.max_depth == Some(depth);
-            let direct = beta * self.direct_light(p, ray.dir, it.phase, !last, rng, c);
+            let direct = beta * self.direct_light(p, ray.dir, it.phase, !last, vertex, draws, c);
             l += direct;
             if depth == 1 {
                 aov.direct += direct;
@@ -195,13 +220,14 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 }
                 emission_only = true;
             }
-            let (dir, pdf) = it.phase.sample(ray.dir, rng.uniform(), rng.uniform());
+            let (u1, u2) = draws.get_2d(Draw::Phase, vertex);
+            let (dir, pdf) = it.phase.sample(ray.dir, u1, u2);
             phase_pdf = Some(pdf);
             ray = Ray::new(p, dir);
             if depth >= ROULETTE_MIN_DEPTH {
                 let m = beta.max_element();
                 if m < ROULETTE_THROUGHPUT {
-                    if rng.uniform() >= m {
+                    if draws.get_1d(Draw::Roulette, vertex) >= m {
                         break;
                     }
                     beta /= m;
