@@ -170,6 +170,7 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
             medium: Medium {
                 field: FixedGridField::new(medium.field, args.fixed_res),
                 density_scale: medium.density_scale,
+                extinction_tint: medium.extinction_tint,
                 albedo: medium.albedo,
                 phase: medium.phase,
             },

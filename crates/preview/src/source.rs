@@ -9,7 +9,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use cirrus_render::medium::BrickField;
+use cirrus_render::medium::{BrickField, Extinction};
 use cirrus_render::{render, Camera, Phase, RenderControl, Rendered};
 use cirrus_scene::description::SceneDescription;
 use cirrus_scene::{defaults as d, Error, LoneVolume, Overrides, Result, Scene};
@@ -186,7 +186,8 @@ impl Renderer for VolumeRenderer<'_> {
         let (w, h) = s.res;
         self.scene.camera = Camera::new(to_render(from), to_render(to), s.camera_up, s.fov, w, h);
         self.scene.lights = s.lights.clone();
-        if let Some(scale) = o.density_scale {
+        if let Some(rgb) = o.density_scale {
+            let Extinction { scale, tint } = Extinction::split(rgb.vec3());
             // Cells refined for another scale stay correct bounds, only
             // less efficient; refine again past a factor of two.
             let ratio = scale / self.refined_for;
@@ -197,9 +198,10 @@ impl Renderer for VolumeRenderer<'_> {
                 self.refined_for = scale;
             }
             self.scene.medium.density_scale = scale;
+            self.scene.medium.extinction_tint = tint;
         }
         if let Some(a) = o.albedo {
-            self.scene.medium.albedo = Vec3::splat(a);
+            self.scene.medium.albedo = a.vec3();
         }
         if let Some(g) = o.g {
             self.scene.medium.phase = Phase::hg(g);

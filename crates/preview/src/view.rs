@@ -7,6 +7,7 @@
 //! sends can reach the file system.
 
 use cirrus_render::IntegratorKind;
+use cirrus_scene::description::Colour;
 use cirrus_scene::Overrides;
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
@@ -214,8 +215,8 @@ impl View {
             camera_to: Some(DVec3::from_array(c.to)),
             camera_up: Some(Vec3::from_array(c.up)),
             fov: Some(c.fov),
-            density_scale: self.density_scale,
-            albedo: self.albedo,
+            density_scale: self.density_scale.map(Colour::Grey),
+            albedo: self.albedo.map(Colour::Grey),
             g: self.g,
             integrator: Some(integrator),
             step,

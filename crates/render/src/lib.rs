@@ -71,7 +71,8 @@ pub use integrator::{
 };
 pub use light::{Environment, Lights, Sun};
 pub use medium::{
-    Bounds3, BrickField, DensityField, GlobalMedia, Interaction, MajorantSegment, Media, Medium,
+    Bounds3, BrickField, DensityField, Extinction, GlobalMedia, Interaction, MajorantSegment,
+    Media, Medium,
 };
 #[cfg(feature = "testing")]
 pub use medium::{ConstantBox, GridField, MajorantGrid};

@@ -129,6 +129,20 @@ impl Colour {
             Colour::Rgb(c) => c,
         }
     }
+
+    pub fn vec3(self) -> glam::Vec3 {
+        glam::Vec3::from_array(self.rgb())
+    }
+}
+
+/// The command-line form: `x` or `r,g,b`.
+impl std::fmt::Display for Colour {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Colour::Grey(v) => write!(f, "{v}"),
+            Colour::Rgb([r, g, b]) => write!(f, "{r},{g},{b}"),
+        }
+    }
 }
 
 /// One volume instance. `--grid`, `--density-scale`, `--albedo` and `--g`
@@ -144,7 +158,9 @@ pub struct VolumeSpec {
     pub temperature: Option<String>,
     /// Emission grid name: `value * emission_color * emission_scale`.
     pub emission: Option<String>,
-    pub density_scale: Option<f32>,
+    /// Extinction per unit density in 1/world units: one number, or one
+    /// per RGB channel (a chromatic medium).
+    pub density_scale: Option<Colour>,
     pub albedo: Option<Colour>,
     /// Mean cosine of the (first) Henyey-Greenstein lobe, or Draine's g.
     pub g: Option<f32>,
@@ -321,6 +337,7 @@ mod tests {
             [[volume]]
             file = "a.vdb"
             albedo = [0.9, 0.8, 0.7]
+            density_scale = [30, 20, 10]
             transform = { translate = [1, 0, 0], rotate = { axis = [0, 1, 0], degrees = 45 }, scale = 2 }
             [[volume]]
             file = "b.vdb"
@@ -336,6 +353,11 @@ mod tests {
             Some(TransmittanceEstimator::TrackLength)
         );
         assert_eq!(s.volumes[0].albedo.unwrap().rgb(), [0.9, 0.8, 0.7]);
+        assert_eq!(
+            s.volumes[0].density_scale,
+            Some(Colour::Rgb([30.0, 20.0, 10.0]))
+        );
+        assert_eq!(s.volumes[1].density_scale, None);
         assert_eq!(s.volumes[1].blackbody.temperature_scale, Some(1000.0));
     }
 }

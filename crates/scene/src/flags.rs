@@ -9,6 +9,7 @@ use cirrus_render::exr_layers::Aov;
 use cirrus_render::{Crop, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
 use glam::{DVec3, Vec3};
 
+use crate::description::Colour;
 use crate::overrides::Overrides;
 use crate::parse;
 
@@ -88,13 +89,14 @@ pub struct SceneFlags {
     /// Multiplier of the sky map's radiance [default: 1].
     #[arg(long)]
     pub env_intensity: Option<f32>,
-    /// Extinction per unit density, in 1/world units [default: 0.5 / voxel
-    /// size, so density 1 is half a mean free path per voxel].
-    #[arg(long)]
-    pub density_scale: Option<f32>,
-    /// Single-scattering albedo [default: 0.99].
-    #[arg(long)]
-    pub albedo: Option<f32>,
+    /// Extinction per unit density, in 1/world units: one number, or R,G,B
+    /// for a chromatic medium [default: 0.5 / voxel size, so density 1 is
+    /// half a mean free path per voxel].
+    #[arg(long, value_parser = crate::parse::colour)]
+    pub density_scale: Option<Colour>,
+    /// Single-scattering albedo: one number or R,G,B [default: 0.99].
+    #[arg(long, value_parser = crate::parse::colour)]
+    pub albedo: Option<Colour>,
     /// Henyey-Greenstein asymmetry (of the first lobe of hg2; Draine's g)
     /// [default: 0.6].
     #[arg(long, allow_hyphen_values = true)]

@@ -19,8 +19,8 @@ use crate::description::{Colour, EnvironmentSpec, SceneDescription, SunSpec};
 pub struct Overrides {
     // Volumes.
     pub grid: Option<String>,
-    pub density_scale: Option<f32>,
-    pub albedo: Option<f32>,
+    pub density_scale: Option<Colour>,
+    pub albedo: Option<Colour>,
     pub g: Option<f32>,
     pub phase: Option<String>,
     pub g2: Option<f32>,
@@ -96,7 +96,7 @@ impl Overrides {
         for v in &mut d.volumes {
             set(&mut v.density, self.grid.clone());
             set(&mut v.density_scale, self.density_scale);
-            set(&mut v.albedo, self.albedo.map(Colour::Grey));
+            set(&mut v.albedo, self.albedo);
             set(&mut v.g, self.g);
             set(&mut v.phase, self.phase.clone());
             set(&mut v.g2, self.g2);

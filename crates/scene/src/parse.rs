@@ -2,6 +2,20 @@
 
 use cirrus_render::Crop;
 
+use crate::description::Colour;
+
+/// A colour: one finite number "x" (grey) or three "r,g,b".
+pub fn colour(s: &str) -> Result<Colour, String> {
+    if s.contains(',') {
+        let [r, g, b] = triple(s)?;
+        return Ok(Colour::Rgb([r as f32, g as f32, b as f32]));
+    }
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(Colour::Grey(v)),
+        _ => Err(format!("expected a number or r,g,b, got {s:?}")),
+    }
+}
+
 /// Three finite numbers "x,y,z" (a leading minus is fine).
 pub fn triple(s: &str) -> Result<[f64; 3], String> {
     let v: Vec<f64> = s
@@ -43,6 +57,16 @@ pub fn crop(s: &str) -> Result<Crop, String> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn colours_are_one_number_or_three() {
+        assert_eq!(colour("0.5"), Ok(Colour::Grey(0.5)));
+        assert_eq!(colour("1, 2,3"), Ok(Colour::Rgb([1.0, 2.0, 3.0])));
+        for bad in ["", "x", "1,2", "1,2,3,4", "nan", "inf", "1,nan,2"] {
+            assert!(colour(bad).is_err(), "{bad:?}");
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -7,12 +7,13 @@ use std::path::{Path, PathBuf};
 
 use cirrus_bricks::{BrickVolume, DBounds3};
 use cirrus_render::medium::BrickField;
+use cirrus_render::medium::Extinction;
 use cirrus_render::{Blackbody, DensityField, Phase, VolumeInstance};
 use cirrus_vdb::VolumeFile;
 use glam::{DMat4, DVec3, Vec3};
 
 use crate::defaults as d;
-use crate::description::{ScaleSpec, VolumeSpec};
+use crate::description::{Colour, ScaleSpec, VolumeSpec};
 use crate::error::{Error, Result};
 use crate::grids::{choose_grid, is_cbrk, read_bricks, read_cbrk_file};
 
@@ -26,7 +27,7 @@ pub struct Plan {
     object_to_world: DMat4,
     /// From the grid header, when the file says.
     pub world_box: Option<DBounds3>,
-    density_scale: Option<f32>,
+    density_scale: Option<Colour>,
     albedo: Vec3,
     phase: Phase,
     blackbody: Blackbody,
@@ -212,15 +213,7 @@ impl Files {
             BrickField::new(v, p.object_to_world, centre)
         };
         let density = field(p.density);
-        let density_scale = p
-            .density_scale
-            .unwrap_or_else(|| d::DENSITY_SCALE_PER_VOXEL / density.voxel_size());
-        if !(density_scale.is_finite() && density_scale >= 0.0) {
-            return Err(Error::input(format!(
-                "{}: density scale must be finite and >= 0, got {density_scale}",
-                p.file.display()
-            )));
-        }
+        let extinction = extinction(&p.file, p.density_scale, density.voxel_size())?;
         if !p.albedo.is_finite() || p.albedo.min_element() < 0.0 || p.albedo.max_element() > 1.0 {
             return Err(Error::input(format!(
                 "{}: albedo must lie in [0, 1], got {}",
@@ -228,9 +221,10 @@ impl Files {
                 p.albedo
             )));
         }
-        let density = density.with_refinement(density_scale, refine);
-        let mut inst =
-            VolumeInstance::new(density, density_scale, p.albedo, d::G).with_phase(p.phase.clone());
+        let density = density.with_refinement(extinction.scale, refine);
+        let mut inst = VolumeInstance::new(density, extinction.scale, p.albedo, d::G)
+            .with_phase(p.phase.clone())
+            .with_extinction_tint(extinction.tint);
         if p.emits() {
             inst.emission = Some(cirrus_render::Emission {
                 temperature: p.temperature.map(|i| (field(i), p.blackbody)),
@@ -246,5 +240,56 @@ impl Files {
 
     pub fn grids_loaded(&self) -> u64 {
         self.grids.len() as u64
+    }
+}
+
+/// A volume's extinction per unit density: the given scale (one number or
+/// one per channel, each finite and >= 0), or the default for its voxel
+/// size; split for the renderer ([`Extinction`]).
+pub(crate) fn extinction(
+    file: &Path,
+    given: Option<Colour>,
+    voxel_size: f32,
+) -> Result<Extinction> {
+    let rgb = given.map_or(
+        Vec3::splat(d::DENSITY_SCALE_PER_VOXEL / voxel_size),
+        Colour::vec3,
+    );
+    if !rgb.is_finite() || rgb.min_element() < 0.0 {
+        return Err(Error::input(format!(
+            "{}: density scale must be finite and >= 0 in every channel, got {}",
+            file.display(),
+            given.map_or(rgb.to_string(), |c| c.to_string())
+        )));
+    }
+    Ok(Extinction::split(rgb))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extinction_splits_channels_and_refuses_bad_ones() {
+        let f = Path::new("cloud.vdb");
+        let grey = extinction(f, Some(Colour::Grey(20.0)), 0.1).unwrap();
+        assert_eq!((grey.scale, grey.tint), (20.0, Vec3::ONE));
+        let rgb = extinction(f, Some(Colour::Rgb([10.0, 40.0, 20.0])), 0.1).unwrap();
+        assert_eq!((rgb.scale, rgb.tint), (40.0, Vec3::new(0.25, 1.0, 0.5)));
+        let default = extinction(f, None, 0.25).unwrap();
+        assert_eq!(default.scale, d::DENSITY_SCALE_PER_VOXEL / 0.25);
+        for bad in [
+            [1.0, -1.0, 1.0],
+            [1.0, f32::NAN, 1.0],
+            [f32::INFINITY, 1.0, 1.0],
+        ] {
+            let e = extinction(f, Some(Colour::Rgb(bad)), 0.1)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("cloud.vdb") && e.contains("density scale"),
+                "{e}"
+            );
+        }
     }
 }

@@ -133,6 +133,7 @@ impl Scene {
             let lone = LoneVolume::load(self)?;
             let load_seconds = start.elapsed().as_secs_f64();
             let (scene, mut settings) = lone.prepare()?;
+            integrator_supports(&scene.medium, &settings)?;
             configure(&mut settings, lone.settings.res)?;
             let mut r = render(&scene, &settings);
             r.stats.bytes_read = lone.bytes_read;
@@ -217,18 +218,18 @@ impl LoneVolume {
         let centre = self.centre();
         let field = BrickField::new(volume, DMat4::IDENTITY, centre);
         let camera = camera(s, centre, field.bounds());
-        let density_scale = self
-            .spec
-            .density_scale
-            .unwrap_or(d::DENSITY_SCALE_PER_VOXEL / field.voxel_size());
-        let field = field.with_refinement(density_scale, s.refine_optical_depth);
+        let extinction =
+            crate::plan::extinction(&self.spec.file, self.spec.density_scale, field.voxel_size())?;
+        let field = field.with_refinement(extinction.scale, s.refine_optical_depth);
         let albedo = self
             .spec
             .albedo
             .map_or(Vec3::splat(d::ALBEDO), |a| Vec3::from_array(a.rgb()));
         let phase = crate::plan::phase_of(&self.spec)?;
         let scene = cirrus_render::Scene {
-            medium: Medium::new(field, density_scale, albedo, d::G).with_phase(phase),
+            medium: Medium::new(field, extinction.scale, albedo, d::G)
+                .with_phase(phase)
+                .with_extinction_tint(extinction.tint),
             camera,
             lights: s.lights.clone(),
         };
@@ -314,6 +315,7 @@ fn render_file(
             "no volume is visible and none can light one: nothing to render",
         ));
     }
+    integrator_supports(&volumes, &settings.render)?;
     let load_seconds = start.elapsed().as_secs_f64();
     let mut rendered = render_media(&volumes, &camera, &settings.lights, &settings.render);
     rendered.stats.bytes_read = files.bytes_read();
@@ -321,4 +323,20 @@ fn render_file(
     rendered.stats.volumes_culled = keep.iter().filter(|k| !**k).count() as u64;
     rendered.stats.load_seconds = load_seconds;
     Ok(rendered)
+}
+
+/// Whether the chosen integrator can render `media`: the two-pass marcher
+/// caches one transmittance per light, so it cannot attenuate channels
+/// apart.
+fn integrator_supports<M: cirrus_render::Media>(
+    media: &M,
+    settings: &RenderSettings,
+) -> Result<()> {
+    if media.chromatic() && settings.integrator == cirrus_render::IntegratorKind::RayMarch2Pass {
+        return Err(Error::input(
+            "raymarch2pass caches one transmittance per light and cannot render a chromatic \
+             medium (a density scale per channel); use --integrator path or raymarch",
+        ));
+    }
+    Ok(())
 }

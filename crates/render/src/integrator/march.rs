@@ -8,6 +8,11 @@
 //! visited: every other point has density 0 and would add nothing, so
 //! skipping empty space leaves the estimate unchanged and only saves
 //! lookups (OpenVDB's `vdb_render` marches through everything).
+//!
+//! Every function is generic over [`Channels`]: `f32` for grey media (one
+//! extinction, one transmittance) and `Vec3` for chromatic ones, where
+//! each step looks the three channels up at once and attenuates them
+//! apart. The grey instantiation is the scalar march itself.
 
 use glam::Vec3;
 
@@ -19,6 +24,128 @@ use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
 use crate::tracking::roulette;
+use crate::tracking::spectral::roulette_rgb;
+
+/// Extinction and transmittance of one channel (`f32`) or three (`Vec3`).
+pub(crate) trait Channels: Copy {
+    const ZERO: Self;
+    const ONE: Self;
+    /// Extinction at `p`.
+    fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self;
+    /// Whether any channel has positive extinction (false for NaN).
+    fn any_positive(self) -> bool;
+    fn scale(self, h: f32) -> Self;
+    fn add(self, other: Self) -> Self;
+    fn mul(self, other: Self) -> Self;
+    fn one_minus(self) -> Self;
+    /// `exp(-self)` per channel.
+    fn exp_neg(self) -> Self;
+    /// The smallest channel (a march stops once every channel is opaque).
+    fn min_channel(self) -> f32;
+    /// `self` times a colour, per channel.
+    fn tint(self, v: Vec3) -> Vec3;
+    /// The channels' mean.
+    fn mean(self) -> f32;
+    fn roulette(&mut self, rng: &mut Rng) -> bool;
+}
+
+impl Channels for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline]
+    fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self {
+        medium.sigma_t(p)
+    }
+    #[inline]
+    fn any_positive(self) -> bool {
+        self > 0.0
+    }
+    #[inline]
+    fn scale(self, h: f32) -> Self {
+        self * h
+    }
+    #[inline]
+    fn add(self, other: Self) -> Self {
+        self + other
+    }
+    #[inline]
+    fn mul(self, other: Self) -> Self {
+        self * other
+    }
+    #[inline]
+    fn one_minus(self) -> Self {
+        1.0 - self
+    }
+    #[inline]
+    fn exp_neg(self) -> Self {
+        (-self).exp()
+    }
+    #[inline]
+    fn min_channel(self) -> f32 {
+        self
+    }
+    #[inline]
+    fn tint(self, v: Vec3) -> Vec3 {
+        self * v
+    }
+    #[inline]
+    fn mean(self) -> f32 {
+        self
+    }
+    #[inline]
+    fn roulette(&mut self, rng: &mut Rng) -> bool {
+        roulette(self, rng)
+    }
+}
+
+impl Channels for Vec3 {
+    const ZERO: Self = Vec3::ZERO;
+    const ONE: Self = Vec3::ONE;
+    #[inline]
+    fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self {
+        medium.sigma_t_rgb(p)
+    }
+    #[inline]
+    fn any_positive(self) -> bool {
+        self.max_element() > 0.0
+    }
+    #[inline]
+    fn scale(self, h: f32) -> Self {
+        self * h
+    }
+    #[inline]
+    fn add(self, other: Self) -> Self {
+        self + other
+    }
+    #[inline]
+    fn mul(self, other: Self) -> Self {
+        self * other
+    }
+    #[inline]
+    fn one_minus(self) -> Self {
+        Vec3::ONE - self
+    }
+    #[inline]
+    fn exp_neg(self) -> Self {
+        Vec3::new((-self.x).exp(), (-self.y).exp(), (-self.z).exp())
+    }
+    #[inline]
+    fn min_channel(self) -> f32 {
+        self.min_element()
+    }
+    #[inline]
+    fn tint(self, v: Vec3) -> Vec3 {
+        self * v
+    }
+    #[inline]
+    fn mean(self) -> f32 {
+        self.element_sum() / 3.0
+    }
+    #[inline]
+    fn roulette(&mut self, rng: &mut Rng) -> bool {
+        roulette_rgb(self, rng)
+    }
+}
 
 /// Shadow marches stop once the optical depth passes this: `exp(-30)` is
 /// below 1e-13, far under any pixel's noise.
@@ -29,14 +156,14 @@ pub const MIN_STEP_VOXELS: f32 = 1e-3;
 
 /// Calls `visit(t, sigma_t, counters)` at each jittered lattice point along
 /// `ray` within `[0, t_max]`; `visit` returns false to stop.
-pub(crate) fn march<M: Media>(
+pub(crate) fn march<M: Media, E: Channels>(
     medium: &M,
     ray: &Ray,
     t_max: f32,
     h: f32,
     u: f32,
     c: &mut Counters,
-    mut visit: impl FnMut(f32, f32, &mut Counters) -> bool,
+    mut visit: impl FnMut(f32, E, &mut Counters) -> bool,
 ) {
     let mut origin = None;
     let mut next_k = 0i64;
@@ -56,7 +183,7 @@ pub(crate) fn march<M: Media>(
             }
             k += 1;
             c.density_lookups += 1;
-            let sigma = medium.sigma_t(ray.at(t));
+            let sigma = E::sigma_t(medium, ray.at(t));
             if !visit(t, sigma, c) {
                 return;
             }
@@ -67,16 +194,16 @@ pub(crate) fn march<M: Media>(
 
 /// `exp(-tau)` with `tau` the jittered-march estimate of the optical depth
 /// from `p` toward `dir` (to infinity); counts one shadow ray.
-pub(crate) fn marched_transmittance<M: Media>(
+pub(crate) fn marched_transmittance<M: Media, E: Channels>(
     medium: &M,
     p: Vec3,
     dir: Vec3,
     h: f32,
     rng: &mut Rng,
     c: &mut Counters,
-) -> f32 {
+) -> E {
     c.shadow_rays += 1;
-    let mut tau = 0.0;
+    let mut tau = E::ZERO;
     let ray = Ray::new(p, dir);
     march(
         medium,
@@ -85,12 +212,12 @@ pub(crate) fn marched_transmittance<M: Media>(
         h,
         rng.uniform(),
         c,
-        |_, sigma, _| {
-            tau += sigma * h;
-            tau < TAU_CUTOFF
+        |_, sigma: E, _| {
+            tau = tau.add(sigma.scale(h));
+            tau.min_channel() < TAU_CUTOFF
         },
     );
-    (-tau).exp()
+    tau.exp_neg()
 }
 
 /// Marches a camera ray, accumulating single scattering step by step:
@@ -104,7 +231,11 @@ pub(crate) fn marched_transmittance<M: Media>(
 /// the marched form of `sigma_a Le`. The background is added through the
 /// final `T`; `T` is Russian-rouletted like the trackers' estimates, so the
 /// march stops early in dense media without bias with respect to the march.
-pub(crate) fn march_camera_ray<M: Media>(
+/// Chromatic media (`E = Vec3`) attenuate each channel by its own
+/// extinction, the chosen instance's source weighted per channel by
+/// [`Interaction::weight`](crate::medium::Interaction); alpha is the
+/// channels' mean `1 - T`.
+pub(crate) fn march_camera_ray<M: Media, E: Channels>(
     medium: &M,
     lights: &Lights,
     ray: &Ray,
@@ -115,28 +246,32 @@ pub(crate) fn march_camera_ray<M: Media>(
 ) -> Sample {
     c.paths += 1;
     let emits = medium.emits();
-    let mut tr = 1.0f32;
+    let chromatic = medium.chromatic();
+    let mut tr = E::ONE;
     let mut l = Vec3::ZERO;
     let u = rng.uniform();
-    march(medium, ray, f32::INFINITY, h, u, c, |t, sigma, c| {
-        if sigma.is_nan() || sigma <= 0.0 {
+    march(medium, ray, f32::INFINITY, h, u, c, |t, sigma: E, c| {
+        if !sigma.any_positive() {
             return true;
         }
-        let step_tr = (-sigma * h).exp();
+        let step_tr = sigma.scale(h).exp_neg();
         let p = ray.at(t);
         let it = medium.interaction(p, rng);
         let mut source = it.albedo * in_scatter(p, it.phase, rng, c);
         if emits {
             source += (Vec3::ONE - it.albedo) * medium.emission(p, it.instance, c);
         }
-        l += (tr * (1.0 - step_tr)) * source;
-        tr *= step_tr;
-        roulette(&mut tr, rng)
+        if chromatic {
+            source *= it.weight;
+        }
+        l += tr.mul(step_tr.one_minus()).tint(source);
+        tr = tr.mul(step_tr);
+        tr.roulette(rng)
     });
-    l += tr * escaped_radiance(lights, ray.dir, None, c);
+    l += tr.tint(escaped_radiance(lights, ray.dir, None, c));
     Sample {
         radiance: l,
-        alpha: 1.0 - tr,
+        alpha: 1.0 - tr.mean(),
         ..Default::default()
     }
 }

@@ -9,6 +9,7 @@ use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Draw, Rng, SampleStream};
 use crate::stats::Counters;
+use crate::tracking::spectral::{sample_free_flight_spectral, transmittance_rgb};
 use crate::tracking::{sample_free_flight, transmittance, FreeFlight, TransmittanceEstimator};
 
 /// Russian roulette on path throughput starts after this many scattering
@@ -41,7 +42,14 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 /// - Several media: albedo and phase function are those of the instance
 ///   chosen at the collision ([`Media::interaction`]).
 /// - Alpha is the track-length estimate of `1 - T` along the camera ray:
-///   1 if its first free flight collides, else 0.
+///   1 if its first free flight collides, else 0 (for chromatic media,
+///   else `1 - avg(beta)` with the escape weights, unbiased for the
+///   channels' mean `1 - T`).
+/// - Chromatic media (extinction per channel) take spectral tracking for
+///   free flights and per-channel ratio tracking for shadow rays
+///   ([`crate::tracking::spectral`]); their weights go into `beta`, and
+///   the instance weight of [`Interaction`](crate::medium::Interaction)
+///   corrects the mixture per channel. Grey media never touch that code.
 /// - Numbers: each path vertex draws its free-flight distance, light
 ///   directions, shadow rays' first optical depths, phase direction and
 ///   roulette as the [`Draw`]s of [`crate::sampling`]'s allocation
@@ -59,6 +67,7 @@ pub struct PathTracer<'a, M> {
     lights: Lights,
     estimator: TransmittanceEstimator,
     max_depth: Option<u32>,
+    chromatic: bool,
 }
 
 impl<'a, M: Media> PathTracer<'a, M> {
@@ -73,6 +82,41 @@ impl<'a, M: Media> PathTracer<'a, M> {
             lights: lights.pruned(),
             estimator,
             max_depth,
+            chromatic: medium.chromatic(),
+        }
+    }
+
+    /// A free flight from `ray`: delta tracking, or spectral tracking
+    /// (which weights `beta`) for chromatic media.
+    #[inline]
+    fn free_flight(
+        &self,
+        ray: &Ray,
+        beta: &mut Vec3,
+        rng: &mut Rng,
+        c: &mut Counters,
+    ) -> FreeFlight {
+        if self.chromatic {
+            sample_free_flight_spectral(self.medium, ray, f32::INFINITY, beta, rng, c)
+        } else {
+            sample_free_flight(self.medium, ray, f32::INFINITY, rng, c)
+        }
+    }
+
+    /// Transmittance toward a light at infinity, per channel.
+    #[inline]
+    fn shadow(&self, ray: &Ray, rng: &mut Rng, c: &mut Counters) -> Vec3 {
+        if self.chromatic {
+            transmittance_rgb(self.estimator, self.medium, ray, f32::INFINITY, rng, c)
+        } else {
+            Vec3::splat(transmittance(
+                self.estimator,
+                self.medium,
+                ray,
+                f32::INFINITY,
+                rng,
+                c,
+            ))
         }
     }
 
@@ -137,9 +181,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             Some(_) => return Vec3::ZERO,
         };
         let shadow = Ray::new(p, s.to_light);
-        let tr = draws.leading(draw, vertex, |rng| {
-            transmittance(self.estimator, self.medium, &shadow, f32::INFINITY, rng, c)
-        });
+        let tr = draws.leading(draw, vertex, |rng| self.shadow(&shadow, rng, c));
         s.radiance * (weight * tr)
     }
 }
@@ -171,10 +213,14 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             // vertex `vertex` of the draw allocation.
             let vertex = depth;
             let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
-                sample_free_flight(self.medium, &ray, f32::INFINITY, rng, c)
+                self.free_flight(&ray, &mut beta, rng, c)
             });
-            if depth == 0 && flight != FreeFlight::Escaped {
-                alpha = 1.0;
+            if depth == 0 {
+                alpha = match flight {
+                    FreeFlight::Escaped if self.chromatic => 1.0 - beta.element_sum() / 3.0,
+                    FreeFlight::Escaped => 0.0,
+                    _ => 1.0,
+                };
             }
             let t = match flight {
                 FreeFlight::Escaped if emission_only => break,
@@ -191,6 +237,9 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             };
             let p = ray.at(t);
             let it = self.medium.interaction(p, draws.rng());
+            if self.chromatic {
+                beta *= it.weight;
+            }
             if depth == 0 {
                 aov.albedo = it.albedo;
                 aov.depth = Some(t);

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::march::{march_camera_ray, marched_transmittance};
+use super::march::{march_camera_ray, marched_transmittance, Channels};
 use super::{CameraSampler, Sample};
 use crate::light::Lights;
 use crate::medium::Media;
@@ -20,6 +20,7 @@ use crate::stats::Counters;
 /// along one phase-sampled direction (the phase-to-pdf ratio is then 1). It
 /// converges to the path tracer with `max_depth = 1` as the step shrinks.
 /// Cost per camera ray grows with the square of the number of steps.
+/// Chromatic media are marched per channel (camera and shadow rays).
 pub struct RayMarcher<'a, M> {
     medium: &'a M,
     lights: Lights,
@@ -39,7 +40,7 @@ impl<'a, M: Media> RayMarcher<'a, M> {
     }
 
     /// Phase-weighted light arriving at `p` for a ray travelling along `dir`.
-    fn in_scatter(
+    fn in_scatter<E: Channels>(
         &self,
         p: Vec3,
         dir: Vec3,
@@ -52,14 +53,14 @@ impl<'a, M: Media> RayMarcher<'a, M> {
             // Sampling the disc uniformly: radiance / pdf is the irradiance.
             let ls = sun.sample(rng.uniform(), rng.uniform());
             let f = phase.eval(dir, ls.to_light);
-            let tr = marched_transmittance(self.medium, p, ls.to_light, self.step, rng, c);
-            s += sun.irradiance() * (f * tr);
+            let tr: E = marched_transmittance(self.medium, p, ls.to_light, self.step, rng, c);
+            s += tr.scale(f).tint(sun.irradiance());
         }
         if let Some(env) = &self.lights.environment {
             let (w, _) = phase.sample(dir, rng.uniform(), rng.uniform());
-            let tr = marched_transmittance(self.medium, p, w, self.step, rng, c);
+            let tr: E = marched_transmittance(self.medium, p, w, self.step, rng, c);
             c.env_samples += 1;
-            s += env.eval(w).0 * tr;
+            s += tr.tint(env.eval(w).0);
         }
         s
     }
@@ -67,14 +68,24 @@ impl<'a, M: Media> RayMarcher<'a, M> {
 
 impl<M: Media> CameraSampler for RayMarcher<'_, M> {
     fn sample(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
-        march_camera_ray(
+        if self.medium.chromatic() {
+            self.march::<Vec3>(ray, rng, c)
+        } else {
+            self.march::<f32>(ray, rng, c)
+        }
+    }
+}
+
+impl<M: Media> RayMarcher<'_, M> {
+    fn march<E: Channels>(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
+        march_camera_ray::<M, E>(
             self.medium,
             &self.lights,
             &ray,
             self.step,
             rng,
             c,
-            |p, phase, rng, c| self.in_scatter(p, ray.dir, phase, rng, c),
+            |p, phase, rng, c| self.in_scatter::<E>(p, ray.dir, phase, rng, c),
         )
     }
 }

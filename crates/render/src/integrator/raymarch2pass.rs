@@ -13,7 +13,10 @@ use crate::stats::Counters;
 /// Single scattering with the light looked up (trilinearly) in a
 /// [`LightGrid`] built once, instead of a shadow march per step: cost per
 /// camera ray is linear in its steps. Biased by the grid's resolution and
-/// the truncated angular expansion as well as by the step.
+/// the truncated angular expansion as well as by the step. The grid holds
+/// one transmittance per light: chromatic media are marched as grey by
+/// their largest channel here, so callers refuse them (the scene crate
+/// does).
 pub struct TwoPassMarcher<'a, M> {
     medium: &'a M,
     lights: Lights,
@@ -35,7 +38,7 @@ impl<'a, M: Media> TwoPassMarcher<'a, M> {
 
 impl<M: Media> CameraSampler for TwoPassMarcher<'_, M> {
     fn sample(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
-        march_camera_ray(
+        march_camera_ray::<M, f32>(
             self.medium,
             &self.lights,
             &ray,

@@ -4,7 +4,10 @@
 //!
 //! Extinction is the sum over the media present at a point, so the
 //! trackers only ever see one scalar field and its majorant segments, in
-//! extinction units (1 / render-space length). What differs between
+//! extinction units (1 / render-space length). For chromatic media that
+//! scalar is each instance's largest channel, summed: it bounds every
+//! channel's extinction, so the same majorants serve all three, and
+//! [`Media::sigma_t_rgb`] gives the channels themselves. What differs between
 //! instances, albedo, phase function and emission, is asked for only at a
 //! real collision: [`Media::interaction`] picks the instance that scattered
 //! with probability `sigma_t,i / sigma_t`, which makes the mixture's
@@ -32,6 +35,11 @@ pub struct Interaction<'a> {
     pub phase: &'a Phase,
     /// Index of the chosen instance (0 for a lone medium).
     pub instance: u32,
+    /// Per channel, `sigma_t,i / (sigma_t q_i)`: the chosen instance's
+    /// share of the channel's extinction over the probability `q_i` it was
+    /// chosen with. 1 for grey media, where `q_i` is that share exactly;
+    /// chromatic estimators multiply by it.
+    pub weight: Vec3,
 }
 
 /// The participating media of a scene, in render space.
@@ -45,8 +53,21 @@ pub trait Media: Send + Sync {
     /// extinction units.
     fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_>;
 
-    /// Total extinction coefficient at `p`.
+    /// Total extinction coefficient at `p` (of chromatic media: the sum of
+    /// each instance's largest channel, a bound of every channel).
     fn sigma_t(&self, p: Vec3) -> f32;
+
+    /// Whether extinction differs between colour channels anywhere; when
+    /// false every channel's extinction is [`Media::sigma_t`] and the
+    /// integrators take their scalar paths.
+    fn chromatic(&self) -> bool {
+        false
+    }
+
+    /// Extinction per RGB channel at `p`, each at most [`Media::sigma_t`].
+    fn sigma_t_rgb(&self, p: Vec3) -> Vec3 {
+        Vec3::splat(self.sigma_t(p))
+    }
 
     /// Render-space bounds of where extinction may be non-zero.
     fn bounds(&self) -> Bounds3;
@@ -122,6 +143,15 @@ impl<F: DensityField> Media for Medium<F> {
         self.density_scale * self.field.density(p)
     }
 
+    fn chromatic(&self) -> bool {
+        self.extinction_tint != Vec3::ONE
+    }
+
+    #[inline]
+    fn sigma_t_rgb(&self, p: Vec3) -> Vec3 {
+        self.extinction_tint * self.sigma_t(p)
+    }
+
     fn bounds(&self) -> Bounds3 {
         self.field.bounds()
     }
@@ -140,6 +170,7 @@ impl<F: DensityField> Media for Medium<F> {
             albedo: self.albedo,
             phase: &self.phase,
             instance: 0,
+            weight: Vec3::ONE,
         }
     }
 }
@@ -181,6 +212,12 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
 
     fn sigma_t(&self, p: Vec3) -> f32 {
         self.inner.sigma_t(p)
+    }
+    fn chromatic(&self) -> bool {
+        self.inner.chromatic()
+    }
+    fn sigma_t_rgb(&self, p: Vec3) -> Vec3 {
+        self.inner.sigma_t_rgb(p)
     }
     fn bounds(&self) -> Bounds3 {
         self.inner.bounds()

@@ -35,16 +35,25 @@ use glam::Vec3;
 
 use crate::phase::Phase;
 
-/// A grey participating medium: `sigma_t(p) = density_scale * density(p)`,
-/// `sigma_s = albedo * sigma_t` per colour channel, and a phase function.
+/// A participating medium: extinction
+/// `sigma_t,c(p) = extinction_tint_c * density_scale * density(p)` per RGB
+/// channel `c`, `sigma_s = albedo * sigma_t` per channel, and a phase
+/// function.
 ///
-/// Extinction is grey, so free-flight sampling and transmittance are scalar;
-/// a coloured albedo only tints the path throughput.
+/// `density_scale` is the largest channel's extinction per unit density,
+/// so the field's majorants scaled by it bound every channel; the tint is
+/// each channel's share of it, in [0, 1]. A grey medium (tint 1, 1, 1)
+/// samples free flights and transmittance as scalars; a coloured albedo
+/// then only tints the path throughput. A chromatic one takes the spectral
+/// trackers ([`crate::tracking::spectral`]).
 #[derive(Clone, Debug)]
 pub struct Medium<F> {
     pub field: F,
-    /// Converts field density to extinction in 1 / render-space units.
+    /// Converts field density to the largest channel's extinction, in
+    /// 1 / render-space units.
     pub density_scale: f32,
+    /// Each channel's extinction relative to `density_scale`, in [0, 1].
+    pub extinction_tint: Vec3,
     /// Single-scattering albedo `sigma_s / sigma_t` per RGB channel, in [0, 1].
     pub albedo: Vec3,
     pub phase: Phase,
@@ -57,6 +66,7 @@ impl<F: DensityField> Medium<F> {
         Self {
             field,
             density_scale,
+            extinction_tint: Vec3::ONE,
             albedo,
             phase: Phase::hg(g),
         }
@@ -66,9 +76,51 @@ impl<F: DensityField> Medium<F> {
         Self { phase, ..self }
     }
 
-    /// Extinction coefficient at `p`.
+    /// Sets extinction per channel: `density_scale` times `tint`, whose
+    /// largest component must be 1 ([`Extinction::split`] gives both).
+    pub fn with_extinction_tint(self, extinction_tint: Vec3) -> Self {
+        Self {
+            extinction_tint,
+            ..self
+        }
+    }
+
+    /// Extinction coefficient at `p` (the largest channel's).
     #[inline]
     pub fn sigma_t(&self, p: Vec3) -> f32 {
         self.density_scale * self.field.density(p)
+    }
+}
+
+/// Extinction per unit density and RGB channel, split into what the
+/// trackers need: the largest channel's scale (what majorants are scaled
+/// by) and each channel's share of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extinction {
+    pub scale: f32,
+    /// In [0, 1], largest component 1; `Vec3::ONE` for grey media.
+    pub tint: Vec3,
+}
+
+impl Extinction {
+    /// Splits a per-channel extinction scale (finite and >= 0 each). Equal
+    /// channels give exactly `(scale, ONE)`, so grey media stay grey bit
+    /// for bit.
+    pub fn split(rgb: Vec3) -> Self {
+        let scale = rgb.max_element();
+        if rgb.x == rgb.y && rgb.y == rgb.z || scale <= 0.0 {
+            return Self {
+                scale,
+                tint: Vec3::ONE,
+            };
+        }
+        Self {
+            scale,
+            tint: (rgb / scale).min(Vec3::ONE),
+        }
+    }
+
+    pub fn is_grey(&self) -> bool {
+        self.tint == Vec3::ONE
     }
 }

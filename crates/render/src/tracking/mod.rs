@@ -1,6 +1,7 @@
 //! Null-collision trackers over a field's majorant segments: free-flight
 //! sampling (`delta`) and three transmittance estimators (`ratio`,
-//! `residual`, `track_length`), all built on the walk in `walk`.
+//! `residual`, `track_length`), all built on the walk in `walk`; and their
+//! per-channel counterparts for chromatic media in [`spectral`].
 //!
 //! Every tracker caps its collisions per call at [`MAX_COLLISIONS`]
 //! (counted in `Counters::collision_cap_hits`; a capped call returns zero
@@ -10,6 +11,7 @@
 mod delta;
 mod ratio;
 mod residual;
+pub mod spectral;
 mod track_length;
 mod walk;
 

@@ -62,8 +62,12 @@ impl<F: DensityField> Emission<F> {
 /// One volume of a scene.
 pub struct VolumeInstance<F> {
     pub density: F,
-    /// Extinction per unit density, in 1 / render-space units.
+    /// The largest channel's extinction per unit density, in
+    /// 1 / render-space units.
     pub density_scale: f32,
+    /// Each channel's extinction relative to `density_scale`, in [0, 1]
+    /// ([`Medium`](crate::Medium) states the convention).
+    pub extinction_tint: Vec3,
     pub albedo: Vec3,
     pub phase: Phase,
     pub emission: Option<Emission<F>>,
@@ -76,6 +80,7 @@ impl<F: DensityField> VolumeInstance<F> {
         Self {
             density,
             density_scale,
+            extinction_tint: Vec3::ONE,
             albedo,
             phase: Phase::hg(g),
             emission: None,
@@ -86,16 +91,24 @@ impl<F: DensityField> VolumeInstance<F> {
         Self { phase, ..self }
     }
 
+    pub fn with_extinction_tint(self, extinction_tint: Vec3) -> Self {
+        Self {
+            extinction_tint,
+            ..self
+        }
+    }
+
     #[inline]
     fn sigma_t(&self, p: Vec3) -> f32 {
         self.density_scale * self.density.density(p)
     }
 
-    fn interaction(&self, instance: usize) -> Interaction<'_> {
+    fn interaction(&self, instance: usize, weight: Vec3) -> Interaction<'_> {
         Interaction {
             albedo: self.albedo,
             phase: &self.phase,
             instance: instance as u32,
+            weight,
         }
     }
 }
@@ -108,6 +121,7 @@ pub struct Volumes<F> {
     voxel_size: f32,
     max_sigma_t: f32,
     emits: bool,
+    chromatic: bool,
 }
 
 impl<F: DensityField> Volumes<F> {
@@ -124,6 +138,7 @@ impl<F: DensityField> Volumes<F> {
             .map(|i| i.density_scale * i.density.global_majorant())
             .sum();
         let emits = instances.iter().any(|i| i.emission.is_some());
+        let chromatic = instances.iter().any(|i| i.extinction_tint != Vec3::ONE);
         Self {
             top: TopLevel::new(boxes),
             instances,
@@ -131,6 +146,7 @@ impl<F: DensityField> Volumes<F> {
             voxel_size,
             max_sigma_t,
             emits,
+            chromatic,
         }
     }
 
@@ -213,6 +229,24 @@ impl<F: DensityField> Media for Volumes<F> {
         sigma
     }
 
+    fn chromatic(&self) -> bool {
+        self.chromatic
+    }
+
+    #[inline]
+    fn sigma_t_rgb(&self, p: Vec3) -> Vec3 {
+        if self.instances.len() == 1 {
+            let inst = &self.instances[0];
+            return inst.extinction_tint * inst.sigma_t(p);
+        }
+        let mut sigma = Vec3::ZERO;
+        self.top.containing(p, |i| {
+            let inst = &self.instances[i];
+            sigma += inst.extinction_tint * inst.sigma_t(p);
+        });
+        sigma
+    }
+
     fn bounds(&self) -> Bounds3 {
         self.bounds
     }
@@ -226,19 +260,23 @@ impl<F: DensityField> Media for Volumes<F> {
     }
 
     /// One instance: its material, no random number. Several: each
-    /// instance containing `p` with probability `sigma_t,i / sigma_t`; a
-    /// random number is drawn only when two or more have density there.
+    /// instance containing `p` with probability `sigma_t,i / sigma_t`
+    /// (largest channels, for chromatic media, with the per-channel
+    /// correction in [`Interaction::weight`]); a random number is drawn
+    /// only when two or more have density there.
     fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
         if self.instances.len() == 1 {
-            return self.instances[0].interaction(0);
+            return self.instances[0].interaction(0, Vec3::ONE);
         }
         let mut found: smallvec::SmallVec<[(usize, f32); 4]> = smallvec::SmallVec::new();
         let mut total = 0.0;
+        let mut total_rgb = Vec3::ZERO;
         self.top.containing(p, |i| {
             let s = self.instances[i].sigma_t(p);
             if s > 0.0 {
                 found.push((i, s));
                 total += s;
+                total_rgb += self.instances[i].extinction_tint * s;
             }
         });
         let chosen = match found.len() {
@@ -255,7 +293,7 @@ impl<F: DensityField> Media for Volumes<F> {
                 });
                 first
             }
-            1 => found[0].0,
+            1 => return self.instances[found[0].0].interaction(found[0].0, Vec3::ONE),
             _ => {
                 let mut x = rng.uniform() * total;
                 let mut pick = found[found.len() - 1].0;
@@ -269,7 +307,15 @@ impl<F: DensityField> Media for Volumes<F> {
                 pick
             }
         };
-        self.instances[chosen].interaction(chosen)
+        let weight = if self.chromatic && found.len() > 1 {
+            // sigma_t,i,c / (sigma_t,c q_i) with q_i = s_i / total.
+            let tint = self.instances[chosen].extinction_tint;
+            let ratio = (tint * total) / total_rgb;
+            Vec3::select(total_rgb.cmpgt(Vec3::ZERO), ratio, Vec3::ZERO)
+        } else {
+            Vec3::ONE
+        };
+        self.instances[chosen].interaction(chosen, weight)
     }
 
     fn emits(&self) -> bool {
