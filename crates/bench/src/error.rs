@@ -8,13 +8,20 @@
 //! twice as fast but four times noisier is slower: efficiency is
 //! 1 / (MSE x time), reported relative to the Mitsuba-like baseline (delta
 //! tracking + ratio tracking over one global majorant) at the same budget.
+//!
+//! Beside the estimators and structures (all with the default Sobol
+//! sampler), three configurations of the default one show what the
+//! sampler, adaptive sampling and denoising each give: independent random
+//! numbers instead of Sobol points, adaptive sampling at
+//! `--noise-threshold`, and Open Image Denoise on the finished image (its
+//! time counted; left out, with a note, where the library does not load).
 
 use crate::fixed_grid::FixedGridField;
 use crate::BenchResult;
 use cirrus_render::medium::BrickField;
 use cirrus_render::{
-    render, Budget, IntegratorKind, MajorantMode, Medium, RenderSettings, Scene,
-    TransmittanceEstimator,
+    render, Adaptive, Budget, IntegratorKind, MajorantMode, Medium, RenderSettings, SamplerKind,
+    Scene, TransmittanceEstimator,
 };
 use cirrus_scene::{Scene as SceneFile, SceneFlags};
 use std::fmt::Write as _;
@@ -42,6 +49,13 @@ pub struct ErrorArgs {
     /// Cells per axis of the fixed majorant grid (pbrt-v4's NanoVDB medium uses 64).
     #[arg(long, default_value_t = 64)]
     pub fixed_res: i32,
+    /// Relative error at which the adaptive configuration stops a pixel.
+    #[arg(long, default_value_t = 0.02)]
+    pub adaptive_threshold: f32,
+    /// Measure only the configurations whose names contain one of these
+    /// (comma-separated); the baseline is always measured.
+    #[arg(long, value_delimiter = ',')]
+    pub only: Vec<String>,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -67,7 +81,29 @@ struct Config {
     transmittance: TransmittanceEstimator,
     structure: Structure,
     step: f32,
+    sampler: SamplerKind,
+    adaptive: Option<Adaptive>,
+    denoise: bool,
 }
+
+impl Config {
+    /// An unbiased configuration with the default sampler.
+    fn path(name: String, transmittance: TransmittanceEstimator, structure: Structure) -> Self {
+        Config {
+            name,
+            integrator: IntegratorKind::Path,
+            transmittance,
+            structure,
+            step: 1.0,
+            sampler: SamplerKind::Sobol,
+            adaptive: None,
+            denoise: false,
+        }
+    }
+}
+
+/// The baseline every efficiency is relative to: Mitsuba 3's scheme.
+const BASELINE: &str = "delta + ratio, global";
 
 /// One measured render.
 struct Row {
@@ -91,14 +127,40 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
             (TransmittanceEstimator::Residual, "residual"),
             (TransmittanceEstimator::TrackLength, "track-length"),
         ] {
-            v.push(Config {
-                name: format!("delta + {tn}, {}", structure.name()),
-                integrator: IntegratorKind::Path,
-                transmittance: t,
+            v.push(Config::path(
+                format!("delta + {tn}, {}", structure.name()),
+                t,
                 structure,
-                step: 1.0,
-            });
+            ));
         }
+    }
+    // The default configuration with each of the image-level techniques.
+    // Their names do not start with "delta": the ceiling compares
+    // majorant structures at equal sampling.
+    let default = |name: &str| {
+        Config::path(
+            format!("{name}: delta + residual, hierarchy"),
+            TransmittanceEstimator::Residual,
+            Structure::Hierarchy,
+        )
+    };
+    v.push(Config {
+        sampler: SamplerKind::Random,
+        ..default("random numbers")
+    });
+    v.push(Config {
+        adaptive: Some(Adaptive {
+            threshold: args.adaptive_threshold,
+            min_spp: cirrus_scene::defaults::MIN_SPP,
+        }),
+        ..default(&format!("adaptive {}%", 100.0 * args.adaptive_threshold))
+    });
+    match cirrus_scene::denoise_available() {
+        Ok(()) => v.push(Config {
+            denoise: true,
+            ..default("OIDN")
+        }),
+        Err(e) => eprintln!("not measuring denoising: {e}"),
     }
     for &step in &args.steps {
         for (k, kn) in [
@@ -106,13 +168,18 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
             (IntegratorKind::RayMarch2Pass, "raymarch2pass"),
         ] {
             v.push(Config {
-                name: format!("{kn}, step {step}"),
                 integrator: k,
-                transmittance: TransmittanceEstimator::Ratio,
-                structure: Structure::Hierarchy,
                 step,
+                ..Config::path(
+                    format!("{kn}, step {step}"),
+                    TransmittanceEstimator::Ratio,
+                    Structure::Hierarchy,
+                )
             });
         }
+    }
+    if !args.only.is_empty() {
+        v.retain(|c| c.name == BASELINE || args.only.iter().any(|o| c.name.contains(o.as_str())));
     }
     v
 }
@@ -189,6 +256,9 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
         budget,
         seed,
         step_voxels: c.step,
+        sampler: c.sampler,
+        adaptive: c.adaptive,
+        aovs: c.denoise,
         progress: false,
         ..base.clone()
     };
@@ -213,13 +283,11 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
             px
         }
         None => {
-            let c = Config {
-                name: "reference".into(),
-                integrator: IntegratorKind::Path,
-                transmittance: TransmittanceEstimator::Residual,
-                structure: Structure::Hierarchy,
-                step: 1.0,
-            };
+            let c = Config::path(
+                "reference".into(),
+                TransmittanceEstimator::Residual,
+                Structure::Hierarchy,
+            );
             eprintln!(
                 "rendering the reference ({} s, delta + residual, hierarchy) ...",
                 args.reference_time
@@ -241,13 +309,17 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
     let mut rows = Vec::new();
     for c in configs(args) {
         for &b in &args.budgets {
-            let r = render_with(&c, &settings_for(&c, Budget::Time(b), base.seed));
+            let mut r = render_with(&c, &settings_for(&c, Budget::Time(b), base.seed));
+            if c.denoise {
+                cirrus_scene::denoise(&mut r)?;
+            }
             let (mse, rel_mse) = errors(&r.image.rgba, &reference);
             let s = &r.stats;
             let row = Row {
                 config: c.name.clone(),
                 budget: b,
-                wall: s.wall_seconds,
+                // The denoiser's time is part of the image's cost.
+                wall: s.wall_seconds + s.denoise_seconds,
                 spp: s.spp,
                 mse,
                 rel_mse,
@@ -355,7 +427,6 @@ fn write_csv(path: &Path, rows: &[Row]) -> std::io::Result<()> {
 /// (geometric mean over budgets of MSE_base x t_base / (MSE x t)), then
 /// the ceiling any majorant structure has on this scene (see `ceiling`).
 fn report(args: &ErrorArgs, rows: &[Row], w: u32, h: u32, collision_ns: f64) -> String {
-    const BASELINE: &str = "delta + ratio, global";
     let mut s = String::new();
     let _ = writeln!(
         s,

@@ -25,11 +25,22 @@ fn error_bench_measures_every_configuration_and_reports_the_ceiling() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
 
-    // 9 tracking configurations (3 estimators x 3 structures) and 2 ray
-    // marchers at one step, each at 2 budgets: 22 rows and a header.
+    // 9 tracking configurations (3 estimators x 3 structures), the default
+    // one with random numbers, adaptive and (where the library loads)
+    // denoised, and 2 ray marchers at one step, each at 2 budgets.
+    let denoised = !stderr.contains("not measuring denoising");
+    let configs = 9 + 2 + usize::from(denoised) + 2;
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
-    assert_eq!(rows.len(), 22, "{csv}");
+    assert_eq!(rows.len(), 2 * configs, "{csv}");
+    for name in ["\"random numbers: ", "\"adaptive 2%: "] {
+        assert_eq!(rows.iter().filter(|r| r.starts_with(name)).count(), 2, "{csv}");
+    }
+    assert_eq!(
+        rows.iter().filter(|r| r.starts_with("\"OIDN: ")).count(),
+        2 * usize::from(denoised),
+        "{csv}"
+    );
     for row in &rows {
         let rmse: f64 = row.split(',').nth(4).unwrap().parse().unwrap();
         assert!(rmse.is_finite() && rmse >= 0.0, "{row}");
@@ -44,5 +55,35 @@ fn error_bench_measures_every_configuration_and_reports_the_ceiling() {
         .unwrap_or_else(|| panic!("{report}"));
     assert!(baseline.trim_end().ends_with("| 1.00x |"), "{baseline}");
     assert!(report.contains("## The ceiling on this scene"), "{report}");
+    let _ = std::fs::remove_dir_all(&out_dir);
+}
+
+#[test]
+fn error_bench_measures_only_what_it_is_asked_and_the_baseline() {
+    let out_dir = std::env::temp_dir().join(format!("cirrus_bench_only_{}", std::process::id()));
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/sphere_fog.vdb");
+    let out = Command::new(env!("CARGO_BIN_EXE_cirrus"))
+        .args(["bench", "error", data, "--res", "8x8", "--budgets", "0.02"])
+        .args(["--reference-time", "0.2", "--steps", "1", "--only", "random,track-length"])
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    // Names are quoted: they hold commas.
+    let mut names: Vec<&str> = csv.lines().skip(1).map(|r| r.split('"').nth(1).unwrap()).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "delta + ratio, global",
+            "delta + track-length, fixed grid",
+            "delta + track-length, global",
+            "delta + track-length, hierarchy",
+            "random numbers: delta + residual, hierarchy"
+        ],
+        "{csv}"
+    );
     let _ = std::fs::remove_dir_all(&out_dir);
 }

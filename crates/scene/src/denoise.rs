@@ -22,6 +22,11 @@ fn denoiser() -> Result<&'static Denoiser> {
         .map_err(|e| Error::file(format!("denoise: {e}")))
 }
 
+/// Whether Open Image Denoise loads; the error says how to install it.
+pub fn denoise_available() -> Result<()> {
+    denoiser().map(|_| ())
+}
+
 /// Denoises `r` in place; its AOVs must hold the albedo.
 pub fn denoise(r: &mut Rendered) -> Result<()> {
     let start = Instant::now();

@@ -50,6 +50,7 @@ mod plan;
 mod scene;
 mod settings;
 
+pub use denoise::{denoise, denoise_available};
 pub use description::SceneDescription;
 pub use error::{Error, ErrorKind, Result};
 #[cfg(feature = "clap")]
