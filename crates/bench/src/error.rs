@@ -52,9 +52,10 @@ pub struct ErrorArgs {
     /// Relative error at which the adaptive configuration stops a pixel.
     #[arg(long, default_value_t = 0.02)]
     pub adaptive_threshold: f32,
-    /// Measure only the configurations whose names contain one of these
-    /// (comma-separated); the baseline is always measured.
-    #[arg(long, value_delimiter = ',')]
+    /// Measure only the configurations whose names contain this (names
+    /// hold commas, so repeat the flag for several); the baseline is always
+    /// measured.
+    #[arg(long)]
     pub only: Vec<String>,
 }
 

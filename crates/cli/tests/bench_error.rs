@@ -34,7 +34,11 @@ fn error_bench_measures_every_configuration_and_reports_the_ceiling() {
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len(), 2 * configs, "{csv}");
     for name in ["\"random numbers: ", "\"adaptive 2%: "] {
-        assert_eq!(rows.iter().filter(|r| r.starts_with(name)).count(), 2, "{csv}");
+        assert_eq!(
+            rows.iter().filter(|r| r.starts_with(name)).count(),
+            2,
+            "{csv}"
+        );
     }
     assert_eq!(
         rows.iter().filter(|r| r.starts_with("\"OIDN: ")).count(),
@@ -64,15 +68,32 @@ fn error_bench_measures_only_what_it_is_asked_and_the_baseline() {
     let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/sphere_fog.vdb");
     let out = Command::new(env!("CARGO_BIN_EXE_cirrus"))
         .args(["bench", "error", data, "--res", "8x8", "--budgets", "0.02"])
-        .args(["--reference-time", "0.2", "--steps", "1", "--only", "random,track-length"])
+        .args([
+            "--reference-time",
+            "0.2",
+            "--steps",
+            "1",
+            "--only",
+            "random",
+            "--only",
+            "track-length",
+        ])
         .arg("--out")
         .arg(&out_dir)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     // Names are quoted: they hold commas.
-    let mut names: Vec<&str> = csv.lines().skip(1).map(|r| r.split('"').nth(1).unwrap()).collect();
+    let mut names: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|r| r.split('"').nth(1).unwrap())
+        .collect();
     names.sort();
     assert_eq!(
         names,

@@ -90,7 +90,8 @@ fn render_with<M: Media>(
             (image, aovs, 0.0)
         }
         IntegratorKind::RayMarch => {
-            let s = RayMarcher::new(medium, lights, settings.step_voxels);
+            let s = RayMarcher::new(medium, lights, settings.step_voxels)
+                .with_shadow_step(settings.shadow_step());
             let (image, aovs) = run(&s, camera, settings, start, &mut counters);
             (image, aovs, 0.0)
         }
@@ -98,7 +99,7 @@ fn render_with<M: Media>(
             let grid = LightGrid::build(
                 medium,
                 &lights,
-                settings.step_voxels,
+                settings.shadow_step(),
                 &settings.light_grid,
                 settings.seed,
                 &mut counters,

@@ -76,6 +76,10 @@ pub struct RenderSettings {
     pub max_depth: Option<u32>,
     /// Ray-march step in voxels (ray marchers and the light grid).
     pub step_voxels: f32,
+    /// The ray marchers' shadow-ray step in voxels (OpenVDB `vdb_render`'s
+    /// `-shadowstep`; the light grid's marches are shadow rays too);
+    /// `None`: the step.
+    pub shadow_step_voxels: Option<f32>,
     pub light_grid: LightGridSettings,
     /// Tile edge in pixels.
     pub tile_size: u32,
@@ -124,6 +128,7 @@ impl Default for RenderSettings {
             adaptive: None,
             max_depth: None,
             step_voxels: 0.5,
+            shadow_step_voxels: None,
             light_grid: LightGridSettings::default(),
             tile_size: 16,
             progress: true,
@@ -136,6 +141,11 @@ impl Default for RenderSettings {
 
 impl RenderSettings {
     /// Checks values the renderer would otherwise have to clamp silently.
+    /// The shadow-ray march step in voxels.
+    pub fn shadow_step(&self) -> f32 {
+        self.shadow_step_voxels.unwrap_or(self.step_voxels)
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         match self.budget {
             Budget::Spp(0) => return Err("spp must be at least 1".into()),
@@ -145,6 +155,14 @@ impl RenderSettings {
                 ))
             }
             _ => {}
+        }
+        if let Some(s) = self
+            .shadow_step_voxels
+            .filter(|s| !(s.is_finite() && *s > 0.0))
+        {
+            return Err(format!(
+                "shadow step must be a positive number of voxels, got {s}"
+            ));
         }
         if !(self.step_voxels.is_finite() && self.step_voxels > 0.0) {
             return Err(format!(

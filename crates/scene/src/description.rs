@@ -66,6 +66,8 @@ pub struct RenderSpec {
     pub majorant: Option<MajorantMode>,
     pub max_depth: Option<u32>,
     pub step: Option<f32>,
+    /// The ray marchers' shadow-ray step in voxels (`--shadow-step`).
+    pub shadow_step: Option<f32>,
     /// Majorant cells are refined while crossing one costs more than this
     /// optical depth in null collisions (lone volumes).
     pub refine_optical_depth: Option<f32>,

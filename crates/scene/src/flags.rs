@@ -140,6 +140,10 @@ pub struct SceneFlags {
     /// Ray-march step in voxels [default: 0.5].
     #[arg(long)]
     pub step: Option<f32>,
+    /// The ray marchers' shadow-ray step in voxels, as vdb_render's
+    /// -shadowstep [default: the step].
+    #[arg(long)]
+    pub shadow_step: Option<f32>,
     /// Denoise with Intel Open Image Denoise 2.x (guided by the albedo
     /// AOV); the EXR keeps the noisy image as `noisy.R/G/B`.
     #[arg(long)]
@@ -195,6 +199,7 @@ impl SceneFlags {
             majorant: self.majorant,
             max_depth: self.max_depth,
             step: self.step,
+            shadow_step: self.shadow_step,
             refine_optical_depth: self.refine_optical_depth,
             denoise: self.denoise.then_some(true),
             res: self.res,

@@ -39,6 +39,7 @@ pub struct Overrides {
     pub majorant: Option<MajorantMode>,
     pub max_depth: Option<u32>,
     pub step: Option<f32>,
+    pub shadow_step: Option<f32>,
     pub refine_optical_depth: Option<f32>,
     pub denoise: Option<bool>,
     // Camera.
@@ -118,6 +119,7 @@ impl Overrides {
         set(&mut r.majorant, self.majorant);
         set(&mut r.max_depth, self.max_depth);
         set(&mut r.step, self.step);
+        set(&mut r.shadow_step, self.shadow_step);
         set(&mut r.refine_optical_depth, self.refine_optical_depth);
         set(&mut r.denoise, self.denoise);
         let c = &mut d.camera;

@@ -60,6 +60,7 @@ impl SceneSettings {
             }),
             max_depth: r.max_depth,
             step_voxels: r.step.unwrap_or(d::STEP),
+            shadow_step_voxels: r.shadow_step,
             progress: false,
             ..Default::default()
         };
