@@ -15,6 +15,25 @@ pub fn triple(s: &str) -> Result<[f64; 3], String> {
 }
 
 /// "WxH", each side 1 to 16384.
+/// A shutter `OPEN,CLOSE` in frames (`-0.25,0.25`), open <= close.
+pub fn shutter(s: &str) -> Result<[f32; 2], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [a, b] = parts[..] else {
+        return Err(format!("shutter {s:?}: expected OPEN,CLOSE (frames)"));
+    };
+    let num = |x: &str| {
+        x.parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("shutter {s:?}: {x:?} is not a finite number"))
+    };
+    let (open, close) = (num(a)?, num(b)?);
+    if close < open {
+        return Err(format!("shutter {s:?}: open must not be after close"));
+    }
+    Ok([open, close])
+}
+
 pub fn resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])

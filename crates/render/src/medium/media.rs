@@ -48,6 +48,14 @@ pub trait Media: Send + Sync {
     /// Total extinction coefficient at `p`.
     fn sigma_t(&self, p: Vec3) -> f32;
 
+    /// Total extinction at `p` at shutter time `time` (what the trackers
+    /// look up: a ray's time). Media without motion are the same at every
+    /// time, which is the default.
+    #[inline]
+    fn sigma_t_at(&self, p: Vec3, _time: f32) -> f32 {
+        self.sigma_t(p)
+    }
+
     /// Render-space bounds of where extinction may be non-zero.
     fn bounds(&self) -> Bounds3;
 
@@ -63,6 +71,13 @@ pub trait Media: Send + Sync {
     /// are those of the single-medium renderer.
     fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_>;
 
+    /// [`interaction`](Self::interaction) with the instances' extinctions
+    /// taken at shutter time `time`.
+    #[inline]
+    fn interaction_at(&self, p: Vec3, _time: f32, rng: &mut Rng) -> Interaction<'_> {
+        self.interaction(p, rng)
+    }
+
     /// Whether any instance emits; when false the integrators do no
     /// emission work at all.
     fn emits(&self) -> bool {
@@ -73,6 +88,13 @@ pub trait Media: Send + Sync {
     /// radiative transfer equation is `sigma_a * Le`); counts its lookups.
     fn emission(&self, _p: Vec3, _instance: u32, _c: &mut Counters) -> Vec3 {
         Vec3::ZERO
+    }
+
+    /// [`emission`](Self::emission) at shutter time `time` (emission
+    /// grids move with the density).
+    #[inline]
+    fn emission_at(&self, p: Vec3, _time: f32, instance: u32, c: &mut Counters) -> Vec3 {
+        self.emission(p, instance, c)
     }
 }
 
@@ -120,6 +142,11 @@ impl<F: DensityField> Media for Medium<F> {
     #[inline]
     fn sigma_t(&self, p: Vec3) -> f32 {
         self.density_scale * self.field.density(p)
+    }
+
+    #[inline]
+    fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
+        self.density_scale * self.field.density_at(p, time)
     }
 
     fn bounds(&self) -> Bounds3 {
@@ -182,6 +209,9 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
     fn sigma_t(&self, p: Vec3) -> f32 {
         self.inner.sigma_t(p)
     }
+    fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
+        self.inner.sigma_t_at(p, time)
+    }
     fn bounds(&self) -> Bounds3 {
         self.inner.bounds()
     }
@@ -194,10 +224,16 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
     fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
         self.inner.interaction(p, rng)
     }
+    fn interaction_at(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
+        self.inner.interaction_at(p, time, rng)
+    }
     fn emits(&self) -> bool {
         self.inner.emits()
     }
     fn emission(&self, p: Vec3, instance: u32, c: &mut Counters) -> Vec3 {
         self.inner.emission(p, instance, c)
+    }
+    fn emission_at(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
+        self.inner.emission_at(p, time, instance, c)
     }
 }
