@@ -206,19 +206,36 @@ impl VelocityGrid {
         let f0 = p.floor();
         let c = f0.as_ivec3();
         let f = p - f0;
-        let at = |dx, dy, dz| self.voxel(c + IVec3::new(dx, dy, dz));
+        let v = self.corners(c);
+        // Corners ordered x-major: v[4x + 2y + z].
         let lerp = |a: Vec3, b: Vec3, t: f32| a + (b - a) * t;
-        let x0 = lerp(
-            lerp(at(0, 0, 0), at(0, 0, 1), f.z),
-            lerp(at(0, 1, 0), at(0, 1, 1), f.z),
-            f.y,
-        );
-        let x1 = lerp(
-            lerp(at(1, 0, 0), at(1, 0, 1), f.z),
-            lerp(at(1, 1, 0), at(1, 1, 1), f.z),
-            f.y,
-        );
+        let x0 = lerp(lerp(v[0], v[1], f.z), lerp(v[2], v[3], f.z), f.y);
+        let x1 = lerp(lerp(v[4], v[5], f.z), lerp(v[6], v[7], f.z), f.y);
         lerp(x0, x1, f.x)
+    }
+
+    /// The eight voxels `c + {0, 1}^3`, x-major. When they share one brick
+    /// (7/8 of positions per axis) its map entry is read once.
+    #[inline]
+    fn corners(&self, c: IVec3) -> [Vec3; 8] {
+        let l = c - self.origin;
+        let one_brick = (l & (BRICK - 1)).cmplt(IVec3::splat(BRICK - 1)).all();
+        let code = match self.brick_index(l >> BRICK_LOG2 as i32) {
+            Some(i) if one_brick => self.map[i],
+            _ => {
+                let at = |k: i32| self.voxel(c + IVec3::new(k >> 2, (k >> 1) & 1, k & 1));
+                return [0, 1, 2, 3, 4, 5, 6, 7].map(at);
+            }
+        };
+        match code {
+            BACKGROUND => [self.background; 8],
+            code if code & CONSTANT != 0 => [self.constants[(code & !CONSTANT) as usize]; 8],
+            code => {
+                let base = (code as usize - 1) * 512 + voxel_offset(l.x, l.y, l.z);
+                let s = &self.atlas[base..base + 74];
+                [0, 1, 8, 9, 64, 65, 72, 73].map(|k| load(s[k]))
+            }
+        }
     }
 
     /// Per component, the largest |value| any lookup can return: trilinear
