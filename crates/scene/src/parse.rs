@@ -69,6 +69,10 @@ mod tests {
         assert_eq!(triple("1,-2.5, 3").unwrap(), [1.0, -2.5, 3.0]);
         assert!(triple("1,2").is_err());
         assert!(triple("1,2,nan").is_err());
+        assert_eq!(shutter("-0.25, 0.25").unwrap(), [-0.25, 0.25]);
+        assert_eq!(shutter("0,0").unwrap(), [0.0, 0.0]);
+        assert!(shutter("0.5,0.25").unwrap_err().contains("after"));
+        assert!(shutter("0").is_err() && shutter("0,inf").is_err());
         assert_eq!(resolution("640x360").unwrap(), (640, 360));
         assert_eq!(resolution("8X4").unwrap(), (8, 4));
         assert!(resolution("0x4").is_err());
