@@ -20,7 +20,7 @@ pub const MAX_MAP_BRICKS: u64 = 1 << 27;
 
 /// Slack on the stored bounds against float rounding in the trilinear
 /// lerp, so `min <= density <= max` holds to the last bit.
-const BOUND_SLACK: f32 = 1.0 / (1 << 20) as f32;
+pub(crate) const BOUND_SLACK: f32 = 1.0 / (1 << 20) as f32;
 
 /// Converts a fog-volume (or unknown-class) float grid into bricks.
 ///

@@ -12,7 +12,10 @@
 //! coarsest level and yielding [`MajorantSegment`]s with tight bounds, over the
 //! cells of a [`CellPartition`] (`partition.rs`) fixed once per refinement rule;
 //! [`BrickVolume::trilinear`] is the density lookup. `format.rs` writes and
-//! memory-maps the `.cbrk` file of a converted volume. [`Bounds3`] and
+//! memory-maps the `.cbrk` file of a converted volume. For motion blur,
+//! [`VelocityGrid`] (`velocity.rs`) stores a vec3 velocity grid and
+//! [`BrickVolume::motion_shell`] (`dilate.rs`) dilates the bounds pyramid
+//! so it bounds the density over a whole shutter. [`Bounds3`] and
 //! [`DBounds3`] (`aabb.rs`) are the box types of the whole workspace.
 
 mod aabb;
@@ -20,12 +23,14 @@ mod bounds;
 mod build;
 mod convert;
 mod dda;
+mod dilate;
 mod format;
 mod layout;
 mod partition;
 mod section;
 mod segment;
 mod stream;
+mod velocity;
 mod volume;
 
 pub use aabb::{Bounds3, DBounds3};
@@ -38,6 +43,7 @@ pub use partition::{Cell, CellPartition};
 pub use section::Section;
 pub use segment::MajorantSegment;
 pub use stream::{convert_file, RENDER_PRECISION};
+pub use velocity::VelocityGrid;
 pub use volume::{Atlas, BrickVolume, SourceInfo};
 
 /// Why a conversion or a `.cbrk` load failed.

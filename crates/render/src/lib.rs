@@ -54,6 +54,7 @@ pub mod ray;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod shutter;
 pub mod sobol;
 pub mod stats;
 pub mod tracking;
@@ -72,7 +73,7 @@ pub use integrator::{
 pub use light::{Environment, Lights, Sun};
 pub use medium::{
     Bounds3, BrickField, DensityField, Extinction, GlobalMedia, Interaction, MajorantSegment,
-    Media, Medium,
+    Media, Medium, Velocity, VelocityUnit,
 };
 #[cfg(feature = "testing")]
 pub use medium::{ConstantBox, GridField, MajorantGrid};
@@ -81,6 +82,7 @@ pub use ray::Ray;
 pub use render::{render, render_media, Rendered, Window};
 pub use sampling::{Rng, SampleStream, SamplerKind};
 pub use scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
+pub use shutter::Shutter;
 pub use stats::{Counters, RenderStats};
 pub use tracking::TransmittanceEstimator;
 pub use volumes::{Emission, VolumeInstance, Volumes};

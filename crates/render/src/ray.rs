@@ -2,17 +2,45 @@
 
 use glam::Vec3;
 
-/// A ray `origin + t * dir`. The integrators keep `dir` normalised so t is a
-/// distance in render-space units.
+/// A ray `origin + t * dir` at a shutter `time`. The integrators keep `dir`
+/// normalised so t is a distance in render-space units.
+///
+/// `time` is in frames relative to the frame being rendered (0: the frame's
+/// own instant). Every ray of a camera path carries the time drawn for its
+/// camera sample, so moving media are seen at one instant per path; media
+/// without motion ignore it.
 #[derive(Clone, Copy, Debug)]
 pub struct Ray {
     pub origin: Vec3,
     pub dir: Vec3,
+    pub time: f32,
 }
 
 impl Ray {
+    /// A ray at time 0.
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        Self { origin, dir }
+        Self {
+            origin,
+            dir,
+            time: 0.0,
+        }
+    }
+
+    /// The same ray at shutter time `time`.
+    #[inline]
+    pub fn with_time(self, time: f32) -> Self {
+        Self { time, ..self }
+    }
+
+    /// A ray from `origin` along `dir` at this ray's time (the next ray of
+    /// the same path, or a shadow ray from it).
+    #[inline]
+    pub fn spawn(&self, origin: Vec3, dir: Vec3) -> Self {
+        Self {
+            origin,
+            dir,
+            time: self.time,
+        }
     }
 
     #[inline]

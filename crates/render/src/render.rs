@@ -18,6 +18,7 @@ use crate::light::Lights;
 use crate::medium::{DensityField, GlobalMedia, Media};
 use crate::sampling::{Draw, SampleStream, SamplerKind};
 use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
+use crate::shutter::Shutter;
 use crate::stats::{Counters, RenderStats};
 
 /// A finished render.
@@ -183,6 +184,7 @@ fn run<S: CameraSampler>(
     let passes = Passes {
         sampler,
         camera,
+        shutter: settings.shutter,
         kind: settings.sampler,
         seed: settings.seed,
         progress: &progress,
@@ -289,6 +291,7 @@ enum Plan {
 struct Passes<'a, S> {
     sampler: &'a S,
     camera: &'a Camera,
+    shutter: Shutter,
     kind: SamplerKind,
     seed: u64,
     progress: &'a Progress,
@@ -349,7 +352,8 @@ impl<S: CameraSampler> Passes<'_, S> {
         for s in s0..s1 {
             let mut draws = SampleStream::new(self.kind, self.seed, index, s);
             let (u, v) = draws.get_2d(Draw::PixelJitter, 0);
-            let ray = self.camera.ray(x as f32 + u, y as f32 + v);
+            let time = self.shutter.sample(&draws);
+            let ray = self.camera.ray(x as f32 + u, y as f32 + v).with_time(time);
             let sample = self.sampler.sample_stream(ray, &mut draws, c);
             tile.add(tx, ty, sample, c);
             if rule.is_some_and(|r| r.is_checkpoint(s + 1) && r.converged(&tile.pixels[i])) {

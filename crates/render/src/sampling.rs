@@ -35,6 +35,12 @@
 //! | phase direction | 2 | the scattered direction |
 //! | Russian roulette | 1 | the path's survival |
 //!
+//! With motion blur on (a shutter of non-zero length), the camera sample
+//! also draws its **time**: a 1D set of its own, after every slot above
+//! ([`Draw::Time`]), or with the random sampler a hash of the sample's key
+//! that advances nothing. Either way no other draw moves, so an image
+//! without motion is bit-identical to one rendered before time existed.
+//!
 //! There is no light-selection draw: every scattering event samples each
 //! light. Everything else comes from the hashed [`Rng`]: draws made a
 //! variable number of times (null-collision decisions and the optical
@@ -161,6 +167,8 @@ pub enum Draw {
     SkyShadow,
     Phase,
     Roulette,
+    /// The camera sample's shutter time (one per sample, not per vertex).
+    Time,
 }
 
 impl Draw {
@@ -171,6 +179,8 @@ impl Draw {
     fn slot(self, vertex: u32) -> Option<u32> {
         let k = match self {
             Self::PixelJitter => return Some(0),
+            // After every per-vertex slot, so adding it moved none of them.
+            Self::Time => return Some(1 + SOBOL_VERTICES * Self::PER_VERTEX),
             Self::FreeFlight => 0,
             Self::SunDirection => 1,
             Self::SunShadow => 2,
@@ -185,6 +195,8 @@ impl Draw {
 
 /// Keeps the Sobol seeds apart from the `Rng` keys of the same pixel.
 const SOBOL_DOMAIN: u64 = 0x5e1b_0150_b01c_0de5;
+/// Keeps the random sampler's shutter times apart from its stream.
+const TIME_DOMAIN: u64 = 0x7133_5b0e_c0de_d0e5;
 
 /// The numbers of one camera sample: the hashed [`Rng`] and, with the
 /// Sobol sampler, the pixel's key and the sample's index into its point
@@ -268,6 +280,21 @@ impl SampleStream {
             None => {
                 let u = self.rng.uniform();
                 (u, self.rng.uniform())
+            }
+        }
+    }
+
+    /// The camera sample's shutter-time number in `[0, 1)`: the Sobol
+    /// point of [`Draw::Time`], or (random sampler) a hash of the stream's
+    /// key. Never advances the hashed stream, so drawing it changes no
+    /// other number of the sample.
+    #[inline]
+    pub fn time(&self) -> f32 {
+        match self.points(Draw::Time, 0) {
+            Some((set, i)) => set.get_1d(i),
+            None => {
+                let h = mix64(self.rng.key ^ TIME_DOMAIN);
+                (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
             }
         }
     }

@@ -12,6 +12,7 @@ use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::light::Lights;
 use crate::medium::Medium;
 use crate::sampling::SamplerKind;
+use crate::shutter::Shutter;
 use crate::tracking::TransmittanceEstimator;
 
 /// A volume, a camera and lights at infinity, all in render space.
@@ -92,6 +93,10 @@ pub struct RenderSettings {
     pub aovs: bool,
     /// Progress and cancellation from another thread (bindings, servers).
     pub control: Option<Arc<RenderControl>>,
+    /// Each camera sample's time is drawn over this interval (frames);
+    /// moving media must have been built for the same shutter, so their
+    /// majorants bound every time drawn.
+    pub shutter: Shutter,
 }
 
 /// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
@@ -135,6 +140,7 @@ impl Default for RenderSettings {
             crop: None,
             aovs: false,
             control: None,
+            shutter: Shutter::INSTANT,
         }
     }
 }
@@ -164,6 +170,7 @@ impl RenderSettings {
                 "shadow step must be a positive number of voxels, got {s}"
             ));
         }
+        self.shutter.validate()?;
         if !(self.step_voxels.is_finite() && self.step_voxels > 0.0) {
             return Err(format!(
                 "step must be a positive number of voxels, got {}",

@@ -6,7 +6,9 @@
 //! lining at a fraction of the noise; density 1 is half a mean free path
 //! per voxel.
 
-use cirrus_render::{IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
+use cirrus_render::{
+    IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
+};
 
 pub const RES: (u32, u32) = (512, 512);
 pub const SPP: u32 = 64;
@@ -49,3 +51,13 @@ pub const STEP: f32 = 0.5;
 pub const EXPOSURE: f32 = 0.0;
 /// Grid names looked for when none is given.
 pub const DENSITY_GRID: &str = "density";
+/// The shutter, in frames around the frame (`--shutter`): closed, no
+/// motion blur.
+pub const SHUTTER: [f32; 2] = [0.0, 0.0];
+/// Velocity grids used when the shutter is open and none is named
+/// (`--velocity`): the first vec3 grid with one of these names.
+pub const VELOCITY_GRIDS: [&str; 2] = ["vel", "v"];
+/// Velocity values are world units per frame (`--velocity-unit`)...
+pub const VELOCITY_UNIT: VelocityUnit = VelocityUnit::World;
+/// ...times this (`--velocity-scale`; 1/24 for per-second values at 24 fps).
+pub const VELOCITY_SCALE: f32 = 1.0;

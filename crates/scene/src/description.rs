@@ -11,7 +11,9 @@
 use std::path::{Path, PathBuf};
 
 use cirrus_render::exr_layers::Aov;
-use cirrus_render::{IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
+use cirrus_render::{
+    IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
+};
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
@@ -76,6 +78,9 @@ pub struct RenderSpec {
     /// A frame range, `"A-B"` or `"A-B:STEP"`, for paths holding a frame
     /// pattern (`####`, `%04d`).
     pub frames: Option<String>,
+    /// `[open, close]` in frames around the frame (`--shutter`): motion
+    /// blur from the volumes' velocity grids.
+    pub shutter: Option<[f32; 2]>,
 }
 
 /// `--res`, `--camera-from`, `--camera-to`, `--camera-up`, `--fov`.
@@ -160,6 +165,14 @@ pub struct VolumeSpec {
     pub temperature: Option<String>,
     /// Emission grid name: `value * emission_color * emission_scale`.
     pub emission: Option<String>,
+    /// Velocity grid name (vec3), for motion blur when the shutter is
+    /// open (default: `vel` or `v` if the file has one).
+    pub velocity: Option<String>,
+    /// `"world"` (world units per frame, the default) or `"voxels"`
+    /// (velocity-grid voxels per frame).
+    pub velocity_unit: Option<VelocityUnit>,
+    /// Multiplies the velocity (1/24: per-second values at 24 fps).
+    pub velocity_scale: Option<f32>,
     /// Extinction per unit density in 1/world units: one number, or one
     /// per RGB channel (a chromatic medium).
     pub density_scale: Option<Colour>,

@@ -6,7 +6,9 @@
 use std::path::PathBuf;
 
 use cirrus_render::exr_layers::Aov;
-use cirrus_render::{Crop, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
+use cirrus_render::{
+    Crop, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
+};
 use glam::{DVec3, Vec3};
 
 use crate::description::Colour;
@@ -144,6 +146,22 @@ pub struct SceneFlags {
     /// -shadowstep [default: the step].
     #[arg(long)]
     pub shadow_step: Option<f32>,
+    /// Motion blur: the shutter's open and close times in frames around
+    /// the frame, e.g. -0.25,0.25 (centred) or 0,0.5 [default: 0,0, none].
+    #[arg(long, value_parser = parse::shutter, allow_hyphen_values = true)]
+    pub shutter: Option<[f32; 2]>,
+    /// The vec3 velocity grid moving the volume while the shutter is open
+    /// [default: "vel" or "v" if the file has one].
+    #[arg(long)]
+    pub velocity: Option<String>,
+    /// What velocity values measure: world units or velocity-grid voxels,
+    /// per frame [default: world].
+    #[arg(long, value_enum)]
+    pub velocity_unit: Option<VelocityUnit>,
+    /// Multiplies velocity values, e.g. 0.041667 (1/24) for per-second
+    /// velocities at 24 fps [default: 1].
+    #[arg(long)]
+    pub velocity_scale: Option<f32>,
     /// Denoise with Intel Open Image Denoise 2.x (guided by the albedo
     /// AOV); the EXR keeps the noisy image as `noisy.R/G/B`.
     #[arg(long)]
@@ -188,6 +206,10 @@ impl SceneFlags {
             lobe_weight: self.lobe_weight,
             droplet_diameter: self.droplet_diameter,
             draine_alpha: self.draine_alpha,
+            velocity: self.velocity.clone(),
+            velocity_unit: self.velocity_unit,
+            velocity_scale: self.velocity_scale,
+            shutter: self.shutter,
             spp: self.spp,
             time: self.time,
             seed: self.seed,

@@ -1,11 +1,12 @@
-//! Which grid of a file is the density, and reading one into bricks.
+//! Which grid of a file is the density (or the velocity), and reading
+//! one into bricks.
 
 use std::path::Path;
 
 use cirrus_bricks::{
-    convert_file, read_cbrk, BrickError, BrickVolume, Precision, RENDER_PRECISION,
+    convert_file, read_cbrk, BrickError, BrickVolume, Precision, VelocityGrid, RENDER_PRECISION,
 };
-use cirrus_vdb::{GridInfo, ValueType, VolumeFile};
+use cirrus_vdb::{GridInfo, GridTree, ValueType, VolumeFile};
 
 use crate::defaults::DENSITY_GRID;
 use crate::error::{Error, Result};
@@ -93,4 +94,56 @@ pub fn load_volume(path: &Path, grid: Option<&str>) -> Result<(BrickVolume, u64)
 
 pub fn is_cbrk(path: &Path) -> bool {
     path.extension().is_some_and(|e| e == "cbrk")
+}
+
+/// The velocity grid of a moving volume: the one named (which must be a
+/// vec3 grid), else the first vec3 grid named `vel` or `v`
+/// ([`VELOCITY_GRIDS`](crate::defaults::VELOCITY_GRIDS)), else none.
+pub fn choose_velocity(file: &VolumeFile, name: Option<&str>) -> Result<Option<usize>> {
+    let grids = file.grids();
+    let vec3 = |g: &GridInfo| matches!(g.value_type, Some(ValueType::Vec3f | ValueType::Vec3d));
+    let Some(name) = name else {
+        let by_name = |n: &str| grids.iter().position(|g| g.name == n && vec3(g));
+        return Ok(crate::defaults::VELOCITY_GRIDS
+            .iter()
+            .find_map(|n| by_name(n)));
+    };
+    let index = file
+        .find_grid(name)
+        .map_err(|e| Error::input(e.to_string()))?;
+    let g = grids[index];
+    if !vec3(g) {
+        return Err(Error::input(format!(
+            "{}: grid {name:?} is {} ({}); a velocity grid must be vec3 (vec3s or vec3d)",
+            file.path().display(),
+            g.value_type.map_or("unsupported", |t| t.name()),
+            g.type_name
+        )));
+    }
+    Ok(Some(index))
+}
+
+/// Grid `index` of an open file (a vec3 grid) as a [`VelocityGrid`].
+pub fn read_velocity(file: &VolumeFile, index: usize) -> Result<VelocityGrid> {
+    let grid = file.read_grid(index)?;
+    let m = grid.transform.index_to_world_matrix();
+    let built = match &grid.tree {
+        GridTree::Vec3f(t) => VelocityGrid::from_tree(&grid.name, t, m, |v| v),
+        GridTree::Vec3d(t) => VelocityGrid::from_tree(&grid.name, t, m, |v| v.map(|c| c as f32)),
+        other => {
+            return Err(Error::input(format!(
+                "{}: grid {:?} is {}; a velocity grid must be vec3 (vec3s or vec3d)",
+                file.path().display(),
+                grid.name,
+                other.value_type().name()
+            )))
+        }
+    };
+    built.map_err(|e| {
+        Error::input(format!(
+            "{}: grid {:?}: {e}",
+            file.path().display(),
+            grid.name
+        ))
+    })
 }

@@ -5,7 +5,9 @@
 use std::path::PathBuf;
 
 use cirrus_render::exr_layers::Aov;
-use cirrus_render::{Crop, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator};
+use cirrus_render::{
+    Crop, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
+};
 use glam::{DVec3, Vec3};
 use serde::Deserialize;
 
@@ -27,6 +29,9 @@ pub struct Overrides {
     pub lobe_weight: Option<f32>,
     pub droplet_diameter: Option<f32>,
     pub draine_alpha: Option<f32>,
+    pub velocity: Option<String>,
+    pub velocity_unit: Option<VelocityUnit>,
+    pub velocity_scale: Option<f32>,
     // Render.
     pub spp: Option<u32>,
     pub time: Option<f64>,
@@ -42,6 +47,8 @@ pub struct Overrides {
     pub shadow_step: Option<f32>,
     pub refine_optical_depth: Option<f32>,
     pub denoise: Option<bool>,
+    /// `[open, close]`, frames.
+    pub shutter: Option<[f32; 2]>,
     // Camera.
     #[serde(default, deserialize_with = "resolution")]
     pub res: Option<(u32, u32)>,
@@ -104,6 +111,9 @@ impl Overrides {
             set(&mut v.lobe_weight, self.lobe_weight);
             set(&mut v.droplet_diameter, self.droplet_diameter);
             set(&mut v.draine_alpha, self.draine_alpha);
+            set(&mut v.velocity, self.velocity.clone());
+            set(&mut v.velocity_unit, self.velocity_unit);
+            set(&mut v.velocity_scale, self.velocity_scale);
         }
         let r = &mut d.render;
         if self.spp.is_some() || self.time.is_some() {
@@ -122,6 +132,7 @@ impl Overrides {
         set(&mut r.shadow_step, self.shadow_step);
         set(&mut r.refine_optical_depth, self.refine_optical_depth);
         set(&mut r.denoise, self.denoise);
+        set(&mut r.shutter, self.shutter);
         let c = &mut d.camera;
         set(&mut c.res, self.res);
         if let (Some(from), Some(to)) = (self.camera_from, self.camera_to) {

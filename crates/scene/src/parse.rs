@@ -29,6 +29,25 @@ pub fn triple(s: &str) -> Result<[f64; 3], String> {
 }
 
 /// "WxH", each side 1 to 16384.
+/// A shutter `OPEN,CLOSE` in frames (`-0.25,0.25`), open <= close.
+pub fn shutter(s: &str) -> Result<[f32; 2], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [a, b] = parts[..] else {
+        return Err(format!("shutter {s:?}: expected OPEN,CLOSE (frames)"));
+    };
+    let num = |x: &str| {
+        x.parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("shutter {s:?}: {x:?} is not a finite number"))
+    };
+    let (open, close) = (num(a)?, num(b)?);
+    if close < open {
+        return Err(format!("shutter {s:?}: open must not be after close"));
+    }
+    Ok([open, close])
+}
+
 pub fn resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
@@ -74,6 +93,10 @@ mod tests {
         assert_eq!(triple("1,-2.5, 3").unwrap(), [1.0, -2.5, 3.0]);
         assert!(triple("1,2").is_err());
         assert!(triple("1,2,nan").is_err());
+        assert_eq!(shutter("-0.25, 0.25").unwrap(), [-0.25, 0.25]);
+        assert_eq!(shutter("0,0").unwrap(), [0.0, 0.0]);
+        assert!(shutter("0.5,0.25").unwrap_err().contains("after"));
+        assert!(shutter("0").is_err() && shutter("0,inf").is_err());
         assert_eq!(resolution("640x360").unwrap(), (640, 360));
         assert_eq!(resolution("8X4").unwrap(), (8, 4));
         assert!(resolution("0x4").is_err());

@@ -4,18 +4,23 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-use cirrus_bricks::{BrickVolume, DBounds3};
+use cirrus_bricks::{BrickVolume, DBounds3, VelocityGrid};
 use cirrus_render::medium::BrickField;
 use cirrus_render::medium::Extinction;
-use cirrus_render::{Blackbody, DensityField, Phase, VolumeInstance};
+use cirrus_render::{
+    Blackbody, DensityField, Phase, Shutter, Velocity, VelocityUnit, VolumeInstance,
+};
 use cirrus_vdb::VolumeFile;
-use glam::{DMat4, DVec3, Vec3};
+use glam::{DMat3, DMat4, DVec3, Vec3};
 
 use crate::defaults as d;
 use crate::description::{Colour, ScaleSpec, VolumeSpec};
 use crate::error::{Error, Result};
-use crate::grids::{choose_grid, is_cbrk, read_bricks, read_cbrk_file};
+use crate::grids::{
+    choose_grid, choose_velocity, is_cbrk, read_bricks, read_cbrk_file, read_velocity,
+};
 
 /// One volume's plan: where its grids are and how it is placed.
 pub struct Plan {
@@ -24,6 +29,10 @@ pub struct Plan {
     density: usize,
     temperature: Option<usize>,
     emission: Option<usize>,
+    /// The velocity grid, when the shutter is open and the file has one.
+    velocity: Option<usize>,
+    velocity_unit: VelocityUnit,
+    velocity_scale: f32,
     object_to_world: DMat4,
     /// From the grid header, when the file says.
     pub world_box: Option<DBounds3>,
@@ -64,8 +73,10 @@ fn object_to_world(v: &VolumeSpec) -> DMat4 {
 }
 
 /// The plan of volume `v` (its file already relative to the working
-/// directory); opens its file, reading the index only.
-pub fn plan(v: &VolumeSpec, files: &mut Files) -> Result<Plan> {
+/// directory); opens its file, reading the index only. `moving`: the
+/// shutter reaches away from the frame's instant, so a velocity grid is
+/// looked for.
+pub fn plan(v: &VolumeSpec, files: &mut Files, moving: bool) -> Result<Plan> {
     let path = v.file.clone();
     let object_to_world = object_to_world(v);
     if !object_to_world.is_finite() || object_to_world.determinant().abs() < 1e-300 {
@@ -76,9 +87,9 @@ pub fn plan(v: &VolumeSpec, files: &mut Files) -> Result<Plan> {
     }
     let cbrk = is_cbrk(&path);
     let (density, temperature, emission, world_box) = if cbrk {
-        if v.temperature.is_some() || v.emission.is_some() {
+        if v.temperature.is_some() || v.emission.is_some() || (moving && v.velocity.is_some()) {
             return Err(Error::input(format!(
-                "{}: a .cbrk holds one density grid; temperature and emission need the .vdb",
+                "{}: a .cbrk holds one density grid; temperature, emission and velocity need the .vdb",
                 path.display()
             )));
         }
@@ -102,6 +113,17 @@ pub fn plan(v: &VolumeSpec, files: &mut Files) -> Result<Plan> {
         });
         (density, temperature, emission, world_box)
     };
+    let velocity = match (moving, cbrk) {
+        (true, false) => choose_velocity(files.open(&path)?, v.velocity.as_deref())?,
+        _ => None,
+    };
+    let velocity_scale = v.velocity_scale.unwrap_or(d::VELOCITY_SCALE);
+    if !velocity_scale.is_finite() {
+        return Err(Error::input(format!(
+            "{}: velocity scale must be finite, got {velocity_scale}",
+            path.display()
+        )));
+    }
     let bb = &v.blackbody;
     Ok(Plan {
         file: path,
@@ -109,6 +131,9 @@ pub fn plan(v: &VolumeSpec, files: &mut Files) -> Result<Plan> {
         density,
         temperature,
         emission,
+        velocity,
+        velocity_unit: v.velocity_unit.unwrap_or(d::VELOCITY_UNIT),
+        velocity_scale,
         object_to_world,
         world_box,
         density_scale: v.density_scale,
@@ -150,12 +175,28 @@ pub fn phase_of(v: &VolumeSpec) -> Result<Phase> {
     phase.map_err(|e| Error::input(format!("{}: {e}", v.file.display())))
 }
 
+/// `field` moving with `velocity` over `shutter`, if it has one.
+fn moved<'v>(
+    field: BrickField<'v>,
+    velocity: Option<&Velocity>,
+    shutter: Shutter,
+    file: &Path,
+) -> Result<BrickField<'v>> {
+    match velocity {
+        Some(v) => field
+            .with_motion(v, shutter)
+            .map_err(|e| Error::input(format!("{}: {e}", file.display()))),
+        None => Ok(field),
+    }
+}
+
 /// Open files and loaded grids, shared by the volumes that use them (two
 /// instances of one file read it once), with what reading them cost.
 #[derive(Default)]
 pub struct Files {
     open: HashMap<PathBuf, VolumeFile>,
     grids: HashMap<(PathBuf, usize), BrickVolume>,
+    velocities: HashMap<(PathBuf, usize), Arc<VelocityGrid>>,
     cbrk_bytes: u64,
 }
 
@@ -190,7 +231,48 @@ impl Files {
         Ok(DBounds3::new(DVec3::ZERO, v.local_extent().as_dvec3()).transformed(m))
     }
 
+    /// A plan's velocity (its grid read once), if it moves.
+    fn velocity(&mut self, p: &Plan) -> Result<Option<Velocity>> {
+        let Some(index) = p.velocity else {
+            return Ok(None);
+        };
+        let key = (p.file.clone(), index);
+        if !self.velocities.contains_key(&key) {
+            let grid = read_velocity(self.open(&p.file)?, index)?;
+            self.velocities.insert(key.clone(), Arc::new(grid));
+        }
+        Ok(Some(Velocity {
+            grid: self.velocities[&key].clone(),
+            unit: p.velocity_unit,
+            scale: p.velocity_scale,
+        }))
+    }
+
+    /// `world_box` (a plan's box) grown by the farthest its density can
+    /// move over `shutter`, for culling.
+    pub fn motion_box(
+        &mut self,
+        p: &Plan,
+        world_box: DBounds3,
+        shutter: Shutter,
+    ) -> Result<DBounds3> {
+        let Some(v) = self.velocity(p)? else {
+            return Ok(world_box);
+        };
+        let abs = |m: DMat3| DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        let from_value = match v.unit {
+            VelocityUnit::World => DMat3::IDENTITY,
+            VelocityUnit::Voxels => abs(DMat3::from_mat4(v.grid.index_to_world)),
+        };
+        let reach = f64::from(v.scale.abs() * shutter.max_abs_time());
+        let pad = abs(DMat3::from_mat4(p.object_to_world))
+            * (from_value * v.grid.max_abs().as_dvec3())
+            * reach;
+        Ok(DBounds3::new(world_box.min - pad, world_box.max + pad))
+    }
+
     pub fn load_grids(&mut self, p: &Plan) -> Result<()> {
+        self.velocity(p)?;
         self.grid(&p.file, p.cbrk, p.density)?;
         for index in [p.temperature, p.emission].into_iter().flatten() {
             self.grid(&p.file, p.cbrk, index)?;
@@ -202,12 +284,20 @@ impl Files {
     /// space (world minus `centre`).
     /// Its majorant cells are refined for its density scale, as a lone
     /// volume's are (`refine`: the optical depth a cell may waste).
+    /// Moving (`shutter`, the plan's velocity) when its velocity is loaded.
     pub fn instance(
         &self,
         p: &Plan,
         centre: DVec3,
         refine: f32,
+        shutter: Shutter,
     ) -> Result<VolumeInstance<BrickField<'_>>> {
+        let velocity = p.velocity.map(|index| Velocity {
+            grid: self.velocities[&(p.file.clone(), index)].clone(),
+            unit: p.velocity_unit,
+            scale: p.velocity_scale,
+        });
+        let moved = |f| moved(f, velocity.as_ref(), shutter, &p.file);
         let field = |index: usize| {
             let v = &self.grids[&(p.file.clone(), index)];
             BrickField::new(v, p.object_to_world, centre)
@@ -221,14 +311,20 @@ impl Files {
                 p.albedo
             )));
         }
-        let density = density.with_refinement(extinction.scale, refine);
+        let density = moved(density.with_refinement(extinction.scale, refine))?;
         let mut inst = VolumeInstance::new(density, extinction.scale, p.albedo, d::G)
             .with_phase(p.phase.clone())
             .with_extinction_tint(extinction.tint);
         if p.emits() {
             inst.emission = Some(cirrus_render::Emission {
-                temperature: p.temperature.map(|i| (field(i), p.blackbody)),
-                grid: p.emission.map(|i| (field(i), p.emission_colour)),
+                temperature: p
+                    .temperature
+                    .map(|i| moved(field(i)).map(|f| (f, p.blackbody)))
+                    .transpose()?,
+                grid: p
+                    .emission
+                    .map(|i| moved(field(i)).map(|f| (f, p.emission_colour)))
+                    .transpose()?,
             });
         }
         Ok(inst)

@@ -24,15 +24,16 @@ use cirrus_bricks::{Bounds3, BrickVolume, DBounds3};
 use cirrus_render::medium::BrickField;
 use cirrus_render::{
     render, render_media, Camera, Crop, DensityField, Medium, RenderControl, RenderSettings,
-    Rendered, Volumes,
+    Rendered, Shutter, Velocity, Volumes,
 };
+use cirrus_vdb::VolumeFile;
 use glam::{DMat4, DVec3, Vec3};
 
 use crate::cull::{in_frustum, needed};
 use crate::defaults as d;
 use crate::description::{SceneDescription, VolumeSpec};
 use crate::error::{Error, Result};
-use crate::grids::load_volume;
+use crate::grids::{choose_velocity, is_cbrk, load_volume, read_velocity};
 use crate::output::Outputs;
 use crate::overrides::Overrides;
 use crate::plan::{plan, Files};
@@ -189,6 +190,8 @@ fn parent(path: &Path) -> &Path {
 /// One volume loaded whole, as `cirrus render FILE` renders it.
 pub struct LoneVolume {
     pub volume: BrickVolume,
+    /// What moves it while the shutter is open (none when it is closed).
+    pub velocity: Option<Velocity>,
     /// Bytes read from disk to load it.
     pub bytes_read: u64,
     pub settings: SceneSettings,
@@ -200,8 +203,10 @@ impl LoneVolume {
         let spec = scene.description.volumes[0].clone();
         let settings = scene.settings()?;
         let (volume, bytes_read) = load_volume(&spec.file, spec.density.as_deref())?;
+        let velocity = lone_velocity(&spec, settings.render.shutter)?;
         Ok(LoneVolume {
             volume,
+            velocity,
             bytes_read,
             settings,
             spec,
@@ -221,6 +226,13 @@ impl LoneVolume {
         let extinction =
             crate::plan::extinction(&self.spec.file, self.spec.density_scale, field.voxel_size())?;
         let field = field.with_refinement(extinction.scale, s.refine_optical_depth);
+        // After the camera: a moving volume is framed as its still frame.
+        let field = match &self.velocity {
+            Some(v) => field
+                .with_motion(v, s.render.shutter)
+                .map_err(|e| Error::input(format!("{}: {e}", self.spec.file.display())))?,
+            None => field,
+        };
         let albedo = self
             .spec
             .albedo
@@ -236,6 +248,39 @@ impl LoneVolume {
         scene.validate()?;
         Ok((scene, s.render.clone()))
     }
+}
+
+/// The velocity of a lone volume: read only when the shutter reaches
+/// away from the frame's instant and the file has (or names) one.
+fn lone_velocity(spec: &VolumeSpec, shutter: Shutter) -> Result<Option<Velocity>> {
+    if shutter.max_abs_time() == 0.0 {
+        return Ok(None);
+    }
+    if is_cbrk(&spec.file) {
+        return match &spec.velocity {
+            Some(_) => Err(Error::input(format!(
+                "{}: a .cbrk holds one density grid; velocity needs the .vdb",
+                spec.file.display()
+            ))),
+            None => Ok(None),
+        };
+    }
+    let f = VolumeFile::open(&spec.file)?;
+    let Some(index) = choose_velocity(&f, spec.velocity.as_deref())? else {
+        return Ok(None);
+    };
+    let scale = spec.velocity_scale.unwrap_or(d::VELOCITY_SCALE);
+    if !scale.is_finite() {
+        return Err(Error::input(format!(
+            "{}: velocity scale must be finite, got {scale}",
+            spec.file.display()
+        )));
+    }
+    Ok(Some(Velocity {
+        grid: Arc::new(read_velocity(&f, index)?),
+        unit: spec.velocity_unit.unwrap_or(d::VELOCITY_UNIT),
+        scale,
+    }))
 }
 
 impl LoneVolume {
@@ -265,10 +310,12 @@ fn render_file(
     start: Instant,
 ) -> Result<Rendered> {
     let mut files = Files::default();
+    let shutter = settings.render.shutter;
+    let moving = shutter.max_abs_time() > 0.0;
     let plans = desc
         .volumes
         .iter()
-        .map(|v| plan(v, &mut files))
+        .map(|v| plan(v, &mut files, moving))
         .collect::<Result<Vec<_>>>()?;
     let boxes: Vec<DBounds3> = plans
         .iter()
@@ -288,6 +335,13 @@ fn render_file(
         x1: w,
         y1: h,
     });
+    // Culling sees where the density can move to over the shutter; the
+    // framing and render space above stay those of the still frame.
+    let boxes: Vec<DBounds3> = plans
+        .iter()
+        .zip(boxes)
+        .map(|(p, b)| files.motion_box(p, b, shutter))
+        .collect::<Result<_>>()?;
     let visible: Vec<bool> = boxes
         .iter()
         .map(|b| in_frustum(&camera, window, b.relative_to(centre)))
@@ -307,7 +361,7 @@ fn render_file(
         files.load_grids(p)?;
     }
     let instances = kept()
-        .map(|p| files.instance(p, centre, settings.refine_optical_depth))
+        .map(|p| files.instance(p, centre, settings.refine_optical_depth, shutter))
         .collect::<Result<Vec<_>>>()?;
     let volumes = Volumes::new(instances);
     if volumes.instances().is_empty() {

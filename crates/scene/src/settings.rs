@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use cirrus_render::{Adaptive, Budget, EnvMap, Environment, Lights, RenderSettings, Sun};
+use cirrus_render::{Adaptive, Budget, EnvMap, Environment, Lights, RenderSettings, Shutter, Sun};
 use glam::{DVec3, Vec3};
 
 use crate::defaults as d;
@@ -61,6 +61,10 @@ impl SceneSettings {
             max_depth: r.max_depth,
             step_voxels: r.step.unwrap_or(d::STEP),
             shadow_step_voxels: r.shadow_step,
+            shutter: {
+                let [open, close] = r.shutter.unwrap_or(d::SHUTTER);
+                Shutter::new(open, close)
+            },
             progress: false,
             ..Default::default()
         };

@@ -103,7 +103,7 @@ impl Channels for Vec3 {
     const ONE: Self = Vec3::ONE;
     #[inline]
     fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self {
-        medium.sigma_t_rgb(p)
+        medium.sigma_t_rgb_at(p, 0.0)
     }
     #[inline]
     fn any_positive(self) -> bool {

@@ -120,12 +120,13 @@ impl<'a, M: Media> PathTracer<'a, M> {
         }
     }
 
-    /// NEE at `p`, path vertex `vertex`, for a path arriving along `dir_in`.
+    /// NEE at `p`, path vertex `vertex`, for a path arriving along `ray_in`
+    /// (whose time the shadow rays keep).
     #[allow(clippy::too_many_arguments)]
     fn direct_light(
         &self,
         p: Vec3,
-        dir_in: Vec3,
+        ray_in: &Ray,
         phase: &Phase,
         mis: bool,
         vertex: u32,
@@ -138,7 +139,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             let s = sun.sample(u1, u2);
             c.nee_rays_sun += 1;
             let shadow = (Draw::SunShadow, vertex);
-            l += self.light_term(p, dir_in, phase, s, mis, shadow, draws, c);
+            l += self.light_term(p, ray_in, phase, s, mis, shadow, draws, c);
         }
         if let Some(env) = &self.lights.environment {
             let (u1, u2) = draws.get_2d(Draw::SkyDirection, vertex);
@@ -147,7 +148,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             // A zero-density sample (a pole) is dropped without a shadow ray.
             c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
             let shadow = (Draw::SkyShadow, vertex);
-            l += self.light_term(p, dir_in, phase, s, mis, shadow, draws, c);
+            l += self.light_term(p, ray_in, phase, s, mis, shadow, draws, c);
         }
         l
     }
@@ -158,7 +159,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     fn light_term(
         &self,
         p: Vec3,
-        dir_in: Vec3,
+        ray_in: &Ray,
         phase: &Phase,
         s: LightSample,
         mis: bool,
@@ -166,7 +167,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         draws: &mut SampleStream,
         c: &mut Counters,
     ) -> Vec3 {
-        let f = phase.eval(dir_in, s.to_light);
+        let f = phase.eval(ray_in.dir, s.to_light);
         let weight = match s.pdf {
             None => f,
             Some(light_pdf) if light_pdf > 0.0 => {
@@ -180,7 +181,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             }
             Some(_) => return Vec3::ZERO,
         };
-        let shadow = Ray::new(p, s.to_light);
+        let shadow = ray_in.spawn(p, s.to_light);
         let tr = draws.leading(draw, vertex, |rng| self.shadow(&shadow, rng, c));
         s.radiance * (weight * tr)
     }
@@ -236,7 +237,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 FreeFlight::Collision { t } => t,
             };
             let p = ray.at(t);
-            let it = self.medium.interaction(p, draws.rng());
+            let it = self.medium.interaction_at(p, ray.time, draws.rng());
             if self.chromatic {
                 beta *= it.weight;
             }
@@ -245,7 +246,9 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 aov.depth = Some(t);
             }
             if emits {
-                let e = beta * (Vec3::ONE - it.albedo) * self.medium.emission(p, it.instance, c);
+                let e = beta
+                    * (Vec3::ONE - it.albedo)
+                    * self.medium.emission_at(p, ray.time, it.instance, c);
                 l += e;
                 aov.emission += e;
             }
@@ -258,7 +261,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 break;
             }
             let last = self.max_depth == Some(depth);
-            let direct = beta * self.direct_light(p, ray.dir, it.phase, !last, vertex, draws, c);
+            let direct = beta * self.direct_light(p, &ray, it.phase, !last, vertex, draws, c);
             l += direct;
             if depth == 1 {
                 aov.direct += direct;
@@ -272,7 +275,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             let (u1, u2) = draws.get_2d(Draw::Phase, vertex);
             let (dir, pdf) = it.phase.sample(ray.dir, u1, u2);
             phase_pdf = Some(pdf);
-            ray = Ray::new(p, dir);
+            ray = ray.spawn(p, dir);
             if depth >= ROULETTE_MIN_DEPTH {
                 let m = beta.max_element();
                 if m < ROULETTE_THROUGHPUT {

@@ -6,9 +6,16 @@
 //! 10,000 or 1,000,000 units from the origin is addressed with local index
 //! coordinates of ordinary size. An affine map keeps the ray parameter, so
 //! the bricks' segments come back in the caller's `t`.
+//!
+//! With motion ([`BrickField::with_motion`]) lookups at a time other than
+//! 0 follow the velocity (`motion.rs`) and the segments come from the
+//! volume's dilated motion shell; at time 0, and without motion, nothing
+//! changes.
 
 use super::field::{Bounds3, DensityField};
-use cirrus_bricks::{BrickVolume, CellPartition, DBounds3, SegmentIter};
+use super::motion::{Motion, Velocity};
+use crate::shutter::Shutter;
+use cirrus_bricks::{BrickError, BrickVolume, CellPartition, DBounds3, SegmentIter};
 use glam::{DMat4, DVec3, Mat4, Vec3};
 
 /// A [`BrickVolume`] placed in render space.
@@ -17,6 +24,10 @@ pub struct BrickField<'v> {
     /// The cells the hierarchy walk visits, made for the refinement rule of
     /// [`BrickField::with_refinement`]; `None`: the finest cells.
     partition: Option<CellPartition>,
+    /// The refinement rule the partition was made for: (split, voxel split).
+    refinement: Option<(f32, f32)>,
+    motion: Option<Motion>,
+    render_from_local: DMat4,
     local_from_render: Mat4,
     bounds: Bounds3,
     voxel_size: f32,
@@ -43,6 +54,9 @@ impl<'v> BrickField<'v> {
         BrickField {
             volume,
             partition: None,
+            refinement: None,
+            motion: None,
+            render_from_local,
             local_from_render: local_from_render.as_mat4(),
             bounds,
             voxel_size,
@@ -69,8 +83,63 @@ impl<'v> BrickField<'v> {
         } else {
             (0.0, f32::INFINITY)
         };
-        self.partition = Some(self.volume.partition(split, voxel_split));
+        self.refinement = Some((split, voxel_split));
+        self.partition = Some(
+            self.walked()
+                .partition(split, self.voxel_split(voxel_split)),
+        );
         self
+    }
+
+    /// Makes the field move with `velocity` over `shutter`: lookups at time
+    /// `t` read the density at `x - v(x) t`, and the majorants come from
+    /// the volume's bounds dilated by the largest displacement over the
+    /// shutter, so they bound the density at every time of it. Render
+    /// bounds grow by the same padding. A shutter with no time away from 0
+    /// leaves the field as it was.
+    pub fn with_motion(
+        mut self,
+        velocity: &Velocity,
+        shutter: Shutter,
+    ) -> Result<Self, BrickError> {
+        if shutter.max_abs_time() == 0.0 {
+            return Ok(self);
+        }
+        let motion = Motion::new(self.volume, velocity, shutter)?;
+        let o = -motion.shell_offset.as_dvec3();
+        let local = DBounds3::new(o, o + motion.shell.local_extent().as_dvec3());
+        self.bounds = local
+            .transformed(self.render_from_local)
+            .relative_to(DVec3::ZERO);
+        self.motion = Some(motion);
+        if let Some((split, voxel_split)) = self.refinement {
+            self.partition = Some(
+                self.walked()
+                    .partition(split, self.voxel_split(voxel_split)),
+            );
+        }
+        Ok(self)
+    }
+
+    /// Whether lookups depend on time.
+    pub fn moves(&self) -> bool {
+        self.motion.is_some()
+    }
+
+    /// The volume whose bounds pyramid the walk uses: the motion shell, or
+    /// the volume itself.
+    fn walked(&self) -> &BrickVolume {
+        self.motion.as_ref().map_or(self.volume, |m| &m.shell)
+    }
+
+    /// The shell has no voxels to bound single voxel cells by, so a moving
+    /// field never goes below the finest 4^3 cells.
+    fn voxel_split(&self, voxel_split: f32) -> f32 {
+        if self.motion.is_some() {
+            f32::INFINITY
+        } else {
+            voxel_split
+        }
     }
 
     /// A render-space ray in the volume's local index space (an affine
@@ -99,11 +168,24 @@ impl DensityField for BrickField<'_> {
             .trilinear(self.local_from_render.transform_point3(p))
     }
 
+    #[inline]
+    fn density_at(&self, p: Vec3, time: f32) -> f32 {
+        let q = self.local_from_render.transform_point3(p);
+        match &self.motion {
+            Some(m) if time != 0.0 => self.volume.trilinear(m.source(q, time)),
+            _ => self.volume.trilinear(q),
+        }
+    }
+
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
-        let (o, d) = self.local_ray(origin, dir);
+        let (mut o, d) = self.local_ray(origin, dir);
+        if let Some(m) = &self.motion {
+            o += m.shell_offset;
+        }
+        let walked = self.walked();
         match &self.partition {
-            Some(cells) => self.volume.segments_in(cells, o, d, t_min, t_max),
-            None => self.volume.segments(o, d, t_min, t_max),
+            Some(cells) => walked.segments_in(cells, o, d, t_min, t_max),
+            None => walked.segments(o, d, t_min, t_max),
         }
     }
 

@@ -22,6 +22,15 @@ pub trait DensityField: Send + Sync {
     /// Trilinearly interpolated density at a render-space point (0 outside).
     fn density(&self, p: Vec3) -> f32;
 
+    /// Density at `p` at shutter time `time` (frames from the frame's own
+    /// instant). A moving field looks it up where its velocity brings
+    /// matter from; a still one ignores `time`, so rays at any time see
+    /// exactly [`density`](Self::density).
+    #[inline]
+    fn density_at(&self, p: Vec3, _time: f32) -> f32 {
+        self.density(p)
+    }
+
     /// Front-to-back, disjoint majorant segments covering the ray's overlap
     /// with the field inside `[t_min, t_max]` (gaps mean zero density).
     /// `dir` need not be normalised; t is in units of `dir`.
@@ -46,6 +55,9 @@ impl<T: DensityField + ?Sized> DensityField for &T {
     }
     fn density(&self, p: Vec3) -> f32 {
         (**self).density(p)
+    }
+    fn density_at(&self, p: Vec3, time: f32) -> f32 {
+        (**self).density_at(p, time)
     }
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
         (**self).segments(origin, dir, t_min, t_max)

@@ -57,6 +57,14 @@ pub trait Media: Send + Sync {
     /// each instance's largest channel, a bound of every channel).
     fn sigma_t(&self, p: Vec3) -> f32;
 
+    /// Total extinction at `p` at shutter time `time` (what the trackers
+    /// look up: a ray's time). Media without motion are the same at every
+    /// time, which is the default.
+    #[inline]
+    fn sigma_t_at(&self, p: Vec3, _time: f32) -> f32 {
+        self.sigma_t(p)
+    }
+
     /// Whether extinction differs between colour channels anywhere; when
     /// false every channel's extinction is [`Media::sigma_t`] and the
     /// integrators take their scalar paths.
@@ -64,9 +72,11 @@ pub trait Media: Send + Sync {
         false
     }
 
-    /// Extinction per RGB channel at `p`, each at most [`Media::sigma_t`].
-    fn sigma_t_rgb(&self, p: Vec3) -> Vec3 {
-        Vec3::splat(self.sigma_t(p))
+    /// Extinction per RGB channel at `p` at shutter time `time`, each at
+    /// most [`Media::sigma_t_at`].
+    #[inline]
+    fn sigma_t_rgb_at(&self, p: Vec3, time: f32) -> Vec3 {
+        Vec3::splat(self.sigma_t_at(p, time))
     }
 
     /// Render-space bounds of where extinction may be non-zero.
@@ -84,6 +94,13 @@ pub trait Media: Send + Sync {
     /// are those of the single-medium renderer.
     fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_>;
 
+    /// [`interaction`](Self::interaction) with the instances' extinctions
+    /// taken at shutter time `time`.
+    #[inline]
+    fn interaction_at(&self, p: Vec3, _time: f32, rng: &mut Rng) -> Interaction<'_> {
+        self.interaction(p, rng)
+    }
+
     /// Whether any instance emits; when false the integrators do no
     /// emission work at all.
     fn emits(&self) -> bool {
@@ -94,6 +111,13 @@ pub trait Media: Send + Sync {
     /// radiative transfer equation is `sigma_a * Le`); counts its lookups.
     fn emission(&self, _p: Vec3, _instance: u32, _c: &mut Counters) -> Vec3 {
         Vec3::ZERO
+    }
+
+    /// [`emission`](Self::emission) at shutter time `time` (emission
+    /// grids move with the density).
+    #[inline]
+    fn emission_at(&self, p: Vec3, _time: f32, instance: u32, c: &mut Counters) -> Vec3 {
+        self.emission(p, instance, c)
     }
 }
 
@@ -143,13 +167,18 @@ impl<F: DensityField> Media for Medium<F> {
         self.density_scale * self.field.density(p)
     }
 
+    #[inline]
+    fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
+        self.density_scale * self.field.density_at(p, time)
+    }
+
     fn chromatic(&self) -> bool {
         self.extinction_tint != Vec3::ONE
     }
 
     #[inline]
-    fn sigma_t_rgb(&self, p: Vec3) -> Vec3 {
-        self.extinction_tint * self.sigma_t(p)
+    fn sigma_t_rgb_at(&self, p: Vec3, time: f32) -> Vec3 {
+        self.extinction_tint * self.sigma_t_at(p, time)
     }
 
     fn bounds(&self) -> Bounds3 {
@@ -213,11 +242,14 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
     fn sigma_t(&self, p: Vec3) -> f32 {
         self.inner.sigma_t(p)
     }
+    fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
+        self.inner.sigma_t_at(p, time)
+    }
     fn chromatic(&self) -> bool {
         self.inner.chromatic()
     }
-    fn sigma_t_rgb(&self, p: Vec3) -> Vec3 {
-        self.inner.sigma_t_rgb(p)
+    fn sigma_t_rgb_at(&self, p: Vec3, time: f32) -> Vec3 {
+        self.inner.sigma_t_rgb_at(p, time)
     }
     fn bounds(&self) -> Bounds3 {
         self.inner.bounds()
@@ -231,10 +263,16 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
     fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
         self.inner.interaction(p, rng)
     }
+    fn interaction_at(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
+        self.inner.interaction_at(p, time, rng)
+    }
     fn emits(&self) -> bool {
         self.inner.emits()
     }
     fn emission(&self, p: Vec3, instance: u32, c: &mut Counters) -> Vec3 {
         self.inner.emission(p, instance, c)
+    }
+    fn emission_at(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
+        self.inner.emission_at(p, time, instance, c)
     }
 }

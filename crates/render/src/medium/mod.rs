@@ -9,6 +9,7 @@
 //!   which [`GlobalMedia`] puts over any media.
 //! - `media` defines [`Media`], what the trackers and integrators walk: a
 //!   lone [`Medium`] or several volume instances, in extinction units.
+//! - `motion` moves a brick field with a velocity grid (motion blur).
 
 mod brick_field;
 #[cfg(feature = "testing")]
@@ -20,6 +21,7 @@ mod grid_field;
 #[cfg(feature = "testing")]
 mod majorant_grid;
 mod media;
+mod motion;
 
 pub use brick_field::BrickField;
 #[cfg(feature = "testing")]
@@ -30,6 +32,7 @@ pub use grid_field::GridField;
 #[cfg(feature = "testing")]
 pub use majorant_grid::{DdaSegments, MajorantGrid};
 pub use media::{GlobalMedia, Interaction, Media, Scaled};
+pub use motion::{Velocity, VelocityUnit};
 
 use glam::Vec3;
 

@@ -103,8 +103,8 @@ pub(crate) fn roulette(tr: &mut f32, rng: &mut Rng) -> bool {
     true
 }
 
-/// Density lookup at a tentative collision, counted, with majorant
-/// violations (density above the segment's bound) counted too.
+/// Density lookup at a tentative collision, at the ray's time, counted,
+/// with majorant violations (density above the segment's bound) counted too.
 #[inline]
 pub(crate) fn lookup<M: Media>(
     medium: &M,
@@ -114,7 +114,7 @@ pub(crate) fn lookup<M: Media>(
     c: &mut Counters,
 ) -> f32 {
     c.density_lookups += 1;
-    let sigma = medium.sigma_t(ray.at(t));
+    let sigma = medium.sigma_t_at(ray.at(t), ray.time);
     // A relative slack of 1e-5 forgives the f32 rounding of interpolation.
     if sigma > sigma_maj * (1.0 + 1e-5) {
         c.majorant_violations += 1;

@@ -43,7 +43,7 @@ use super::{FreeFlight, TransmittanceEstimator, ROULETTE_Q, ROULETTE_THRESHOLD};
 #[inline]
 fn lookup_rgb<M: Media>(medium: &M, ray: &Ray, t: f32, sigma_maj: f32, c: &mut Counters) -> Vec3 {
     c.density_lookups += 1;
-    let sigma = medium.sigma_t_rgb(ray.at(t));
+    let sigma = medium.sigma_t_rgb_at(ray.at(t), ray.time);
     if sigma.max_element() > sigma_maj * (1.0 + 1e-5) {
         c.majorant_violations += 1;
     }

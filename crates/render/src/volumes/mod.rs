@@ -41,18 +41,25 @@ impl<F: DensityField> Emission<F> {
     /// Emitted radiance `Le` at `p`.
     #[inline]
     pub fn radiance(&self, p: Vec3, c: &mut Counters) -> Vec3 {
+        self.radiance_at(p, 0.0, c)
+    }
+
+    /// Emitted radiance `Le` at `p` at shutter time `time`: the grids move
+    /// with their own velocity (set on each field), as the density does.
+    #[inline]
+    pub fn radiance_at(&self, p: Vec3, time: f32, c: &mut Counters) -> Vec3 {
         let inside = |f: &F| f.bounds().contains(p);
         let mut le = Vec3::ZERO;
         if let Some((field, bb)) = &self.temperature {
             if inside(field) {
                 c.emission_lookups += 1;
-                le += bb.radiance(field.density(p));
+                le += bb.radiance(field.density_at(p, time));
             }
         }
         if let Some((field, colour)) = &self.grid {
             if inside(field) {
                 c.emission_lookups += 1;
-                le += *colour * field.density(p).max(0.0);
+                le += *colour * field.density_at(p, time).max(0.0);
             }
         }
         le
@@ -99,8 +106,8 @@ impl<F: DensityField> VolumeInstance<F> {
     }
 
     #[inline]
-    fn sigma_t(&self, p: Vec3) -> f32 {
-        self.density_scale * self.density.density(p)
+    fn sigma_t(&self, p: Vec3, time: f32) -> f32 {
+        self.density_scale * self.density.density_at(p, time)
     }
 
     fn interaction(&self, instance: usize, weight: Vec3) -> Interaction<'_> {
@@ -220,12 +227,17 @@ impl<F: DensityField> Media for Volumes<F> {
 
     #[inline]
     fn sigma_t(&self, p: Vec3) -> f32 {
+        self.sigma_t_at(p, 0.0)
+    }
+
+    #[inline]
+    fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
         if self.instances.len() == 1 {
-            return self.instances[0].sigma_t(p);
+            return self.instances[0].sigma_t(p, time);
         }
         let mut sigma = 0.0;
         self.top
-            .containing(p, |i| sigma += self.instances[i].sigma_t(p));
+            .containing(p, |i| sigma += self.instances[i].sigma_t(p, time));
         sigma
     }
 
@@ -234,15 +246,15 @@ impl<F: DensityField> Media for Volumes<F> {
     }
 
     #[inline]
-    fn sigma_t_rgb(&self, p: Vec3) -> Vec3 {
+    fn sigma_t_rgb_at(&self, p: Vec3, time: f32) -> Vec3 {
         if self.instances.len() == 1 {
             let inst = &self.instances[0];
-            return inst.extinction_tint * inst.sigma_t(p);
+            return inst.extinction_tint * inst.sigma_t(p, time);
         }
         let mut sigma = Vec3::ZERO;
         self.top.containing(p, |i| {
             let inst = &self.instances[i];
-            sigma += inst.extinction_tint * inst.sigma_t(p);
+            sigma += inst.extinction_tint * inst.sigma_t(p, time);
         });
         sigma
     }
@@ -265,6 +277,12 @@ impl<F: DensityField> Media for Volumes<F> {
     /// correction in [`Interaction::weight`]); a random number is drawn
     /// only when two or more have density there.
     fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
+        self.interaction_at(p, 0.0, rng)
+    }
+
+    /// As [`interaction`](Media::interaction), with each instance's
+    /// extinction at shutter time `time`.
+    fn interaction_at(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
         if self.instances.len() == 1 {
             return self.instances[0].interaction(0, Vec3::ONE);
         }
@@ -272,7 +290,7 @@ impl<F: DensityField> Media for Volumes<F> {
         let mut total = 0.0;
         let mut total_rgb = Vec3::ZERO;
         self.top.containing(p, |i| {
-            let s = self.instances[i].sigma_t(p);
+            let s = self.instances[i].sigma_t(p, time);
             if s > 0.0 {
                 found.push((i, s));
                 total += s;
@@ -324,8 +342,13 @@ impl<F: DensityField> Media for Volumes<F> {
 
     #[inline]
     fn emission(&self, p: Vec3, instance: u32, c: &mut Counters) -> Vec3 {
+        self.emission_at(p, 0.0, instance, c)
+    }
+
+    #[inline]
+    fn emission_at(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
         match &self.instances[instance as usize].emission {
-            Some(e) => e.radiance(p, c),
+            Some(e) => e.radiance_at(p, time, c),
             None => Vec3::ZERO,
         }
     }
