@@ -7,7 +7,9 @@ efficiency: the figures of BENCHMARKS.md, "Peers: Cycles 5.2 and Mitsuba 3 on ph
     python tools/phase_peers.py list
 
 Run it with a python that has numpy and either mitsuba or the `OpenEXR` module (to read EXRs),
-e.g. /work/peer/bpy-venv/bin/python.  It starts the renderers as subprocesses, one at a time,
+e.g. /work/peer/bpy-venv/bin/python, or /work/peer/mi-venv/bin/python for the Mitsuba-only
+cases (`--cases rgb_ss rgb_ms`: chromatic media, extinction per RGB channel, against
+Mitsuba's volpathmis; see mitsuba_render.py).  It starts the renderers as subprocesses, one at a time,
 under `nice -n 5`:
 
     cirrus   --cirrus (default /tmp/cirrus-peer/cirrus, else target/release/cirrus)
@@ -96,6 +98,16 @@ _case("mie10_sunonly_ss", "cycles",
 _case("draine_sunonly_ss", "cycles",
       NOSKY + SUN + ["--sun-angle", "0", "--phase", "draine", "--g", "0.5", "--draine-alpha", "1", "--max-depth", "1"],
       256, 128)
+
+# Chromatic media (extinction per RGB channel) against Mitsuba's volpathmis (spectral MIS), HG g 0.5,
+# delta sun + sky.  Density scale 0.8,0.5,0.25 (channels 3.2x apart; the grey cases use 0.5) and
+# albedo 0.95,0.9,0.8.  Mitsuba's single global majorant makes it ~15x slower per sample than
+# cirrus on this cloud: few spp per run (the ratios' standard errors come from all pixels).
+RGB_VIEW = [{"0.5": "0.8,0.5,0.25", "0.9": "0.95,0.9,0.8"}.get(f, f) if i > 0 and VIEW[i - 1] in
+            ("--density-scale", "--albedo") else f for i, f in enumerate(VIEW)]
+_case("rgb_ms", "mitsuba", RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5"], 128, 16)
+_case("rgb_ss", "mitsuba", RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5", "--max-depth", "1"],
+      256, 32)
 
 
 def log(msg: str) -> None:
