@@ -117,6 +117,10 @@ _case("rgb_ms_split", "mitsuba", RGB_VIEW + SUN + ["--sun-angle", "0", "--phase"
       split=True)
 _case("rgb_ms_cgrey", "cirrus", RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5"], 128, 64,
       split=True)
+_case("rgb_ss_split", "mitsuba",
+      RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5", "--max-depth", "1"], 1024, 128, split=True)
+_case("rgb_ss_cgrey", "cirrus",
+      RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5", "--max-depth", "1"], 1024, 512, split=True)
 
 
 def channel_flags(flags: list, c: int) -> list:
