@@ -18,6 +18,13 @@ meaning and the same defaults, builds the scene
     lights     directional(direction = --sun-dir, irradiance), constant(--env-radiance)
     integrator volpath, max_depth = cirrus max depth + 1 (-1 = unlimited)
 
+Chromatic media (`--density-scale R,G,B` with unequal channels, cirrus's extinction per RGB
+channel): sigma_t is a 3-channel gridvolume holding density x scale_c per channel (derived
+from the 1-channel .vol by vdb_to_mitsuba_vol.scale_channels, same bbox bytes), `scale` 1,
+`has_spectral_extinction` true, and the integrator is `volpathmis` (Miller et al. 2019's
+spectral MIS over the channels; same max_depth and rr_depth conventions as volpath).
+`--albedo R,G,B` is a constvolume of that RGB value (with grey extinction volpath handles it).
+
 and writes an RGBA float32 EXR.  Mitsuba's film alpha is only "the path hit something
 or an environment exists" (always 1 with a constant sky), so alpha = 1 - T of the camera
 ray is rendered by a second, cheap pass of the same geometry: albedo 0, no sun, a
@@ -65,6 +72,17 @@ def vec3(s: str) -> tuple[float, float, float]:
     if len(parts) != 3 or not all(math.isfinite(c) for c in parts):
         raise argparse.ArgumentTypeError(f"expected three finite numbers x,y,z, got {s!r}")
     return tuple(parts)
+
+
+def scalar_or_rgb(s: str) -> tuple[float, ...]:
+    """'0.5' -> (0.5,); '0.8,0.5,0.25' -> (0.8, 0.5, 0.25), like cirrus's flags."""
+    try:
+        parts = tuple(float(c) for c in s.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number or R,G,B, got {s!r}") from None
+    if len(parts) not in (1, 3) or not all(math.isfinite(c) and c >= 0 for c in parts):
+        raise argparse.ArgumentTypeError(f"expected one number or R,G,B (finite, >= 0), got {s!r}")
+    return parts
 
 
 def resolution(s: str) -> tuple[int, int]:
@@ -124,9 +142,12 @@ def parse_args(argv=None):
                          "--sun-angle 0 to cirrus for comparisons)")
     ap.add_argument("--no-sun", action="store_true")
     ap.add_argument("--env-radiance", type=vec3, default=(0.16, 0.22, 0.34))
-    ap.add_argument("--density-scale", type=float, default=None,
-                    help="extinction per unit density in 1/world units (default 0.5 / voxel size)")
-    ap.add_argument("--albedo", type=float, default=0.99)
+    ap.add_argument("--density-scale", type=scalar_or_rgb, default=None,
+                    help="extinction per unit density in 1/world units: one number, or R,G,B for a chromatic "
+                         "medium (a 3-channel sigma_t grid, volpathmis) (default 0.5 / voxel size)")
+    ap.add_argument("--albedo", type=scalar_or_rgb, default=(0.99,), help="one number or R,G,B")
+    ap.add_argument("--integrator", choices=["auto", "volpath", "volpathmis"], default="auto",
+                    help="auto: volpathmis for a chromatic medium (unequal --density-scale channels), else volpath")
     ap.add_argument("--g", type=float, default=0.6, help="HG g (of the first lobe of hg2)")
     ap.add_argument("--phase", choices=["hg", "hg2", "rayleigh"], default="hg",
                     help="hg: Mitsuba's hg(g); hg2: blendphase of hg(g) and hg(g2), cirrus's two-lobe HG; "
@@ -173,6 +194,14 @@ def parse_args(argv=None):
         ap.error("--max-depth must be >= 0")
     if not (0.0 <= args.lobe_weight <= 1.0):
         ap.error("--lobe-weight must be in [0, 1]")
+    if max(args.albedo) > 1.0:
+        ap.error("--albedo must be in [0, 1]")
+    # Equal channels are a grey medium (the 1-channel grid and its scalar scale).
+    if args.density_scale is not None and len(set(args.density_scale)) == 1:
+        args.density_scale = args.density_scale[:1]
+    args.chromatic = args.density_scale is not None and len(args.density_scale) == 3
+    if args.integrator == "auto":
+        args.integrator = "volpathmis" if args.chromatic else "volpath"
     return args
 
 
@@ -222,7 +251,16 @@ def mitsuba_phase(args) -> dict:
     raise SystemExit(f"unsupported --phase {args.phase!r}")
 
 
-def build_scene(mi, args, vol_path: str, hdr: dict, *, alpha_pass: bool, spp: int):
+def albedo_value(args, alpha_pass: bool):
+    if alpha_pass:
+        return 0.0
+    if len(args.albedo) == 1:
+        return float(args.albedo[0])
+    return {"type": "constvolume", "value": {"type": "rgb", "value": [float(v) for v in args.albedo]}}
+
+
+def build_scene(mi, args, vol_path: str, hdr: dict, *, alpha_pass: bool, spp: int, rgb_vol: str | None = None):
+    """`rgb_vol`: for a chromatic medium, the 3-channel sigma_t .vol (density x scale_c)."""
     w, h = args.res
     bmin = np.array(hdr["bbox_min"], dtype=np.float64)
     bmax = np.array(hdr["bbox_max"], dtype=np.float64)
@@ -258,19 +296,34 @@ def build_scene(mi, args, vol_path: str, hdr: dict, *, alpha_pass: bool, spp: in
         if vs is None or max(vs) - min(vs) > 1e-9 * max(vs):
             raise SystemExit("pass --density-scale (the default 1/voxel size needs a uniform voxel size)")
         density_scale = DEFAULT_DENSITY_PER_VOXEL / vs[0]
-    medium = {
-        "type": "heterogeneous",
-        "sigma_t": {"type": "gridvolume", "filename": vol_path, "use_grid_bbox": True},
-        "scale": float(density_scale),
-        "albedo": 0.0 if alpha_pass else float(args.albedo),
-        "phase": mitsuba_phase(args),
-        # Grey extinction: no per-channel free-flight reweighting needed.
-        "has_spectral_extinction": False,
-    }
+    else:
+        density_scale = density_scale[0] if len(density_scale) == 1 else tuple(density_scale)
+    if args.chromatic:
+        if rgb_vol is None:
+            raise SystemExit("internal: a chromatic medium needs the 3-channel .vol")
+        medium = {
+            "type": "heterogeneous",
+            # sigma_t per channel = density x scale_c, baked into the 3 channels; `scale` 1.
+            "sigma_t": {"type": "gridvolume", "filename": rgb_vol, "use_grid_bbox": True},
+            "scale": 1.0,
+            "albedo": albedo_value(args, alpha_pass),
+            "phase": mitsuba_phase(args),
+            "has_spectral_extinction": True,
+        }
+    else:
+        medium = {
+            "type": "heterogeneous",
+            "sigma_t": {"type": "gridvolume", "filename": vol_path, "use_grid_bbox": True},
+            "scale": float(density_scale),
+            "albedo": albedo_value(args, alpha_pass),
+            "phase": mitsuba_phase(args),
+            # Grey extinction: no per-channel free-flight reweighting needed.
+            "has_spectral_extinction": False,
+        }
     scene = {
         "type": "scene",
         "integrator": {
-            "type": "volpath",
+            "type": args.integrator,
             "max_depth": 1 if alpha_pass else mitsuba_max_depth(args.max_depth),
             "rr_depth": args.rr_depth,
         },
@@ -293,7 +346,7 @@ def build_scene(mi, args, vol_path: str, hdr: dict, *, alpha_pass: bool, spp: in
             }
         if max(args.env_radiance) > 0:
             scene["sky"] = {"type": "constant", "radiance": {"type": "rgb", "value": list(args.env_radiance)}}
-    return mi.load_dict(scene), float(density_scale)
+    return mi.load_dict(scene), density_scale
 
 
 def render_batches(mi, dr, scene, spp_total: int, batches: int, seed: int, npix: int):
@@ -360,7 +413,18 @@ def main(argv=None) -> int:
         raise SystemExit(f"mitsuba_render.py: {args.file}: {e}") from None
     w, h = args.res
     npix = w * h
-    scene, density_scale = build_scene(mi, args, vol_path, hdr, alpha_pass=False, spp=1)
+    rgb_vol, rgb_dir = None, None
+    if args.chromatic:
+        import vdb_to_mitsuba_vol as conv
+
+        if hdr.get("channels", 1) != 1:
+            raise SystemExit(f"mitsuba_render.py: {vol_path}: pass the 1-channel density .vol (or the .vdb)")
+        rgb_dir = tempfile.TemporaryDirectory(prefix="mitsuba_rgbvol_")
+        rgb_vol = str(Path(rgb_dir.name) / "sigma_t_rgb.vol")
+        info = conv.scale_channels(vol_path, rgb_vol, args.density_scale)
+        log(args, f"chromatic: {rgb_vol} = density x {list(args.density_scale)}, max per channel "
+                  f"{info['max_per_channel']}")
+    scene, density_scale = build_scene(mi, args, vol_path, hdr, alpha_pass=False, spp=1, rgb_vol=rgb_vol)
     setup_s = time.time() - t_start
 
     # Warm-up launch so the timed render excludes Dr.Jit's kernel compilation.
@@ -382,13 +446,15 @@ def main(argv=None) -> int:
     var_a = np.zeros((h, w), dtype=np.float64) if var_rgb is not None else None
     alpha_s = 0.0
     if args.alpha == "pass":
-        ascene, _ = build_scene(mi, args, vol_path, hdr, alpha_pass=True, spp=1)
+        ascene, _ = build_scene(mi, args, vol_path, hdr, alpha_pass=True, spp=1, rgb_vol=rgb_vol)
         np.array(mi.render(ascene, seed=1, spp=1))  # compile
         aspp = args.alpha_spp or spp_done
         t_img, t_var, alpha_s, _, _ = render_batches(mi, dr, ascene, aspp, args.batches, args.seed + 7919, npix)
-        alpha = 1.0 - t_img[..., 0]
+        # Chromatic: the channels' mean 1 - T, as cirrus's alpha for chromatic media.
+        alpha = 1.0 - (t_img[..., :3].mean(axis=-1) if args.chromatic else t_img[..., 0])
         if t_var is not None:
-            var_a = t_var[..., 0]
+            # Chromatic: the channels are correlated; the mean of their variances bounds the variance of their mean.
+            var_a = t_var[..., :3].mean(axis=-1) if args.chromatic else t_var[..., 0]
         log(args, f"alpha pass: {aspp} spp, {alpha_s:.2f} s")
 
     rgba = np.concatenate([rgb[..., :3], alpha[..., None]], axis=-1)
@@ -417,6 +483,9 @@ def main(argv=None) -> int:
         "setup_seconds": setup_s,
         "total_seconds": total_s,
         "mitsuba_max_depth": mitsuba_max_depth(args.max_depth),
+        "integrator": args.integrator,
+        "chromatic": args.chromatic,
+        "albedo": list(args.albedo),
         "phase": mitsuba_phase(args),
         "density_scale": density_scale,
         "vol": vol_path,
@@ -430,6 +499,8 @@ def main(argv=None) -> int:
     )
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
+    if rgb_dir is not None:
+        rgb_dir.cleanup()
     return 0
 
 

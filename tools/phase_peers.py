@@ -7,7 +7,9 @@ efficiency: the figures of BENCHMARKS.md, "Peers: Cycles 5.2 and Mitsuba 3 on ph
     python tools/phase_peers.py list
 
 Run it with a python that has numpy and either mitsuba or the `OpenEXR` module (to read EXRs),
-e.g. /work/peer/bpy-venv/bin/python.  It starts the renderers as subprocesses, one at a time,
+e.g. /work/peer/bpy-venv/bin/python, or /work/peer/mi-venv/bin/python for the Mitsuba-only
+cases (`--cases rgb_ss rgb_ms`: chromatic media, extinction per RGB channel, against
+Mitsuba's volpathmis; see mitsuba_render.py).  It starts the renderers as subprocesses, one at a time,
 under `nice -n 5`:
 
     cirrus   --cirrus (default /tmp/cirrus-peer/cirrus, else target/release/cirrus)
@@ -66,8 +68,10 @@ SUN = ["--sun-dir", "-0.45,-0.6,-0.66", "--sun-irradiance", "2.6,2.5,2.3"]
 CASES: dict[str, dict] = {}
 
 
-def _case(name, peer, flags, cirrus_spp, peer_spp):
-    CASES[name] = {"peer": peer, "flags": flags, "cirrus_spp": cirrus_spp, "peer_spp": peer_spp}
+def _case(name, peer, flags, cirrus_spp, peer_spp, split=False):
+    """split: the peer renders each RGB channel as its own grey medium (that channel's density scale
+    and albedo; the channels of a chromatic medium are independent), composed into one image per seed."""
+    CASES[name] = {"peer": peer, "flags": flags, "cirrus_spp": cirrus_spp, "peer_spp": peer_spp, "split": split}
 
 
 # Mitsuba (one global majorant, rr_depth 256) is ~6x slower per sample than Cycles here: fewer spp.
@@ -96,6 +100,36 @@ _case("mie10_sunonly_ss", "cycles",
 _case("draine_sunonly_ss", "cycles",
       NOSKY + SUN + ["--sun-angle", "0", "--phase", "draine", "--g", "0.5", "--draine-alpha", "1", "--max-depth", "1"],
       256, 128)
+
+# Chromatic media (extinction per RGB channel) against Mitsuba's volpathmis (spectral MIS), HG g 0.5,
+# delta sun + sky.  Density scale 0.8,0.5,0.25 (channels 3.2x apart; the grey cases use 0.5) and
+# albedo 0.95,0.9,0.8.  Mitsuba's single global majorant makes it ~15x slower per sample than
+# cirrus on this cloud: few spp per run (the ratios' standard errors come from all pixels).
+RGB_VIEW = [{"0.5": "0.8,0.5,0.25", "0.9": "0.95,0.9,0.8"}.get(f, f) if i > 0 and VIEW[i - 1] in
+            ("--density-scale", "--albedo") else f for i, f in enumerate(VIEW)]
+_case("rgb_ms", "mitsuba", RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5"], 128, 16)
+_case("rgb_ss", "mitsuba", RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5", "--max-depth", "1"],
+      1024, 128)
+# The same chromatic image against three grey renders (channel c: density scale and albedo of channel c):
+# Mitsuba's plain volpath per channel (no spectral MIS, so none of volpathmis's heavy tails), and cirrus's own
+# grey (delta tracking) code per channel (other seeds, 101..), which tests spectral tracking directly.
+_case("rgb_ms_split", "mitsuba", RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5"], 128, 16,
+      split=True)
+_case("rgb_ms_cgrey", "cirrus", RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5"], 128, 64,
+      split=True)
+_case("rgb_ss_split", "mitsuba",
+      RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5", "--max-depth", "1"], 1024, 128, split=True)
+_case("rgb_ss_cgrey", "cirrus",
+      RGB_VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.5", "--max-depth", "1"], 1024, 512, split=True)
+
+
+def channel_flags(flags: list, c: int) -> list:
+    """A chromatic case's flags with --density-scale and --albedo reduced to channel c (grey)."""
+    out = list(flags)
+    for i, f in enumerate(out[:-1]):
+        if f in ("--density-scale", "--albedo") and "," in out[i + 1]:
+            out[i + 1] = out[i + 1].split(",")[c]
+    return out
 
 
 def log(msg: str) -> None:
@@ -285,7 +319,22 @@ def agree(args) -> int:
             if not f.exists():
                 timing["cirrus"].append(R.cirrus_run(flags, f, cspp, s))
             cfiles.append(f)
-        if case["peer"] == "cycles":
+        if case.get("split"):
+            # One grey render per channel and seed; the peer image of seed s takes channel c from render c.
+            pfiles = []
+            for s in seeds:
+                per = []
+                for c, ch in enumerate("RGB"):
+                    f = out / f"{name}_{case['peer']}_{s}_{ch}.exr"
+                    if not f.exists():
+                        cf = channel_flags(flags, c)
+                        if case["peer"] == "mitsuba":
+                            timing["peer"].append(R.mitsuba_run(cf, vol, f, pspp, s))
+                        else:  # cirrus's grey code, seeds independent of the chromatic side's
+                            timing["peer"].append(R.cirrus_run(cf, f, pspp, 100 + s))
+                    per.append(f)
+                pfiles.append(per)
+        elif case["peer"] == "cycles":
             pattern = out / f"{name}_cycles_{{seed}}.exr"
             pfiles = [Path(str(pattern).replace("{seed}", str(s))) for s in seeds]
             if not all(f.exists() for f in pfiles):
@@ -298,11 +347,12 @@ def agree(args) -> int:
                     timing["peer"].append(R.mitsuba_run(flags, vol, f, pspp, s))
                 pfiles.append(f)
         a = side_stats(np.stack([read_rgb(f) for f in cfiles]))
-        b = side_stats(np.stack([read_rgb(f) for f in pfiles]))
+        b = side_stats(np.stack([np.stack([read_rgb(f[c])[..., c] for c in range(3)], axis=-1)
+                                 if isinstance(f, list) else read_rgb(f) for f in pfiles]))
         cmp = compare_sides(a, b)
         write_z_png(out / f"{name}_z.png", cmp.pop("z_rgb_mean_map"))
         prev = results.get(name, {})
-        cmp.update({"peer": case["peer"], "flags": flags, "cirrus_spp": cspp, "peer_spp": pspp, "runs": k,
+        cmp.update({"peer": case["peer"] + (" (grey per channel)" if case.get("split") else ""), "flags": flags, "cirrus_spp": cspp, "peer_spp": pspp, "runs": k,
                     "timing": {kk: [{x: y for x, y in t.items() if x not in ("stdout", "cycles", "mitsuba")}
                                     for t in v] for kk, v in timing.items()} if any(timing.values())
                     else prev.get("timing")})
@@ -313,8 +363,9 @@ def agree(args) -> int:
             f"G {c['G']['cloud_ratio']:.4f} B {c['B']['cloud_ratio']:.4f}; |z|>4 {100 * c['G']['frac_z4']:.2f}% "
             f"(noise {100 * c['G']['expected_z4']:.2f}%), blocks {c['G']['blocks_z4']}/{c['G']['blocks']} -> "
             f"{cmp['verdict']}")
-    (out / "summary.md").write_text(agree_table(results))
-    print(agree_table(results))
+    table = agree_table(results) + "\nPer channel:\n\n" + channel_table(results)
+    (out / "summary.md").write_text(table)
+    print(table)
     return 0
 
 
@@ -332,6 +383,21 @@ def agree_table(results: dict) -> str:
             f"{100 * g['frac_z3']:.2f}% ({100 * g['expected_z3']:.2f}%) | "
             f"{100 * g['frac_z4']:.3f}% ({100 * g['expected_z4']:.3f}%) | {g['blocks_z4']}/{g['blocks']} | "
             f"{r['verdict']} |")
+    return "\n".join(lines) + "\n"
+
+
+def channel_table(results: dict) -> str:
+    """Every channel's ratio with its own standard error and z (chromatic cases differ per channel)."""
+    lines = ["| case | peer | spp x runs (cirrus / peer) | R: peer / cirrus +- s.e. (z) | G | B | "
+             "pixels |z|>4 R/G/B (noise) | 8x8 blocks |z|>4 R/G/B | verdict |", "|---|---|---|---|---|---|---|---|---|"]
+    for name, r in results.items():
+        c = r["channels"]
+        rat = [f"{c[ch]['cloud_ratio']:.4f} +- {c[ch]['cloud_ratio_se']:.4f} ({c[ch]['cloud_ratio_z']:+.1f})" for ch in "RGB"]
+        z4 = "/".join(f"{100 * c[ch]['frac_z4']:.2f}%" for ch in "RGB")
+        bl = "/".join(str(c[ch]["blocks_z4"]) for ch in "RGB")
+        lines.append(f"| {name} | {r['peer']} | {r['cirrus_spp']}x{r['runs']} / {r['peer_spp']}x{r['runs']} | "
+                     f"{' | '.join(rat)} | {z4} ({100 * c['G']['expected_z4']:.2f}%) | {bl} of {c['G']['blocks']} | "
+                     f"{r['verdict']} |")
     return "\n".join(lines) + "\n"
 
 

@@ -5,6 +5,10 @@ Usage (Debian's own interpreter, the only one that can import pyopenvdb):
 
     /usr/bin/python3 tools/vdb_to_mitsuba_vol.py data/cloud.vdb /tmp/cloud.vol [--grid density]
     /usr/bin/python3 tools/vdb_to_mitsuba_vol.py data/cloud.vdb /tmp/cloud.vol --check 4000
+    /usr/bin/python3 tools/vdb_to_mitsuba_vol.py data/cloud.vdb /tmp/rgb.vol --channel-scales 0.8,0.5,0.25 --check 4000
+
+`--channel-scales R,G,B` writes 3 channels (channel c = density x scale_c, interleaved per
+voxel as Mitsuba reads them) for a chromatic medium's `sigma_t` with `scale` 1.
 
 The written grid reproduces cirrus's density field exactly (up to float32 rounding):
 OpenVDB trilinear interpolation between voxel centres (BoxSampler), 0 outside the
@@ -139,18 +143,60 @@ def dense_padded(grid):
     return padded, lo - 1, int(mask.sum())
 
 
-def write_vol(path: str | Path, data_xyz: np.ndarray, bbox_min, bbox_max) -> None:
+def write_vol(path: str | Path, data_xyz: np.ndarray, bbox_min, bbox_max, *, bbox_raw: bytes | None = None) -> None:
     """Mitsuba's .vol: 'VOL', version 3, encoding 1 (float32), xres, yres, zres,
-    channels, bbox (6 float32), then float32 data with x fastest."""
-    nx, ny, nz = data_xyz.shape
-    header = b"VOL" + bytes([3]) + struct.pack("<iiiii", 1, nx, ny, nz, 1)
-    header += struct.pack("<6f", *[float(v) for v in bbox_min], *[float(v) for v in bbox_max])
-    body = np.ascontiguousarray(np.transpose(data_xyz, (2, 1, 0)), dtype="<f4").tobytes()
+    channels, bbox (6 float32), then float32 data with x fastest.  `data_xyz` is
+    [x, y, z] (1 channel) or [x, y, z, c] (c channels, interleaved per voxel as
+    Mitsuba reads them: data[((z * yres + y) * xres + x) * channels + c]).
+    `bbox_raw`: the 24 bbox bytes to write verbatim (copying another file's bbox bit for bit)."""
+    if data_xyz.ndim == 3:
+        data_xyz = data_xyz[..., None]
+    nx, ny, nz, nc = data_xyz.shape
+    if nc not in (1, 3):
+        raise ConversionError(f"{nc} channels: Mitsuba's gridvolume takes 1 or 3 here")
+    header = b"VOL" + bytes([3]) + struct.pack("<iiiii", 1, nx, ny, nz, nc)
+    if bbox_raw is not None:
+        assert len(bbox_raw) == 24
+        header += bbox_raw
+    else:
+        header += struct.pack("<6f", *[float(v) for v in bbox_min], *[float(v) for v in bbox_max])
+    body = np.ascontiguousarray(np.transpose(data_xyz, (2, 1, 0, 3)), dtype="<f4").tobytes()
     tmp = Path(str(path) + ".tmp")
     with open(tmp, "wb") as f:
         f.write(header)
         f.write(body)
     tmp.replace(path)
+
+
+def read_vol(path: str | Path) -> tuple[dict, np.ndarray, bytes]:
+    """(header, data [x, y, z, c] float32, the 24 raw bbox bytes) of a float32 .vol."""
+    hdr = read_vol_header(path)
+    if hdr["encoding"] != 1:
+        raise ConversionError(f"{path}: encoding {hdr['encoding']}, only float32 (1) is read")
+    nx, ny, nz = hdr["res"]
+    nc = hdr["channels"]
+    with open(path, "rb") as f:
+        raw = f.read()
+    body = np.frombuffer(raw, dtype="<f4", offset=48)
+    if body.size != nx * ny * nz * nc:
+        raise ConversionError(f"{path}: {body.size} values, header says {nx}x{ny}x{nz}x{nc}")
+    data = np.transpose(body.reshape(nz, ny, nx, nc), (2, 1, 0, 3))
+    return hdr, data, raw[24:48]
+
+
+def scale_channels(in_vol: str | Path, out_vol: str | Path, scales) -> dict:
+    """A 1-channel density .vol -> a 3-channel .vol whose channel c is density x scales[c]
+    (sigma_t per channel, for a chromatic medium rendered with `scale` 1); the bbox bytes
+    are copied verbatim, so the texel placement is exactly the 1-channel file's."""
+    hdr, data, bbox_raw = read_vol(in_vol)
+    if hdr["channels"] != 1:
+        raise ConversionError(f"{in_vol}: {hdr['channels']} channels, expected a 1-channel density .vol")
+    s = np.asarray([float(v) for v in scales], dtype=np.float64)
+    if s.shape != (3,) or not np.all(np.isfinite(s)) or np.any(s < 0):
+        raise ConversionError(f"channel scales must be three finite numbers >= 0, got {scales!r}")
+    rgb = (data.astype(np.float64) * s).astype(np.float32)  # [x, y, z, 1] * [3] -> [x, y, z, 3]
+    write_vol(out_vol, rgb, None, None, bbox_raw=bbox_raw)
+    return {**hdr, "channels": 3, "scales": s.tolist(), "max_per_channel": rgb.reshape(-1, 3).max(axis=0).tolist()}
 
 
 def read_vol_header(path: str | Path) -> dict:
@@ -229,6 +275,8 @@ def reference_trilinear(grid, scale, trans, pts_world: np.ndarray) -> np.ndarray
 
 
 def mitsuba_eval(vol_path: str, pts_world: np.ndarray, variant: str | None = None) -> np.ndarray:
+    """Mitsuba's gridvolume at the points: shape (N,) for a 1-channel .vol (`eval_1`),
+    (N, 3) for a 3-channel one (`eval`, RGB variants: the channels as stored)."""
     import mitsuba_setup
 
     mi, dr = mitsuba_setup.mitsuba(variant)
@@ -236,6 +284,10 @@ def mitsuba_eval(vol_path: str, pts_world: np.ndarray, variant: str | None = Non
     it = dr.zeros(mi.Interaction3f, len(pts_world))
     p = pts_world.astype(np.float32)
     it.p = mi.Point3f(mi.Float(p[:, 0]), mi.Float(p[:, 1]), mi.Float(p[:, 2]))
+    if read_vol_header(vol_path)["channels"] == 3:
+        if not mi.variant().endswith("_rgb"):
+            raise ConversionError(f"--check of a 3-channel .vol needs an RGB variant, not {mi.variant()}")
+        return np.array(vol.eval(it), dtype=np.float64).reshape(3, -1).T
     return np.array(vol.eval_1(it), dtype=np.float64).reshape(-1)
 
 
@@ -262,22 +314,26 @@ def check_points(info: dict, n: int, seed: int) -> np.ndarray:
     return idx * scale + trans
 
 
-def run_check(info: dict, vol_path: str, n: int, seed: int, variant: str | None) -> dict:
+def run_check(info: dict, vol_path: str, n: int, seed: int, variant: str | None, scales=None) -> dict:
+    """`scales`: the .vol holds density x scales[c] in channel c (written by --channel-scales)."""
     # Both sides get the same float32 points (Mitsuba's positions are float32).
     pts = check_points(info, n, seed).astype(np.float32).astype(np.float64)
     t0 = time.time()
     ref = reference_trilinear(info["_grid"], info["_scale"], info["_trans"], pts)
     t1 = time.time()
     got = mitsuba_eval(vol_path, pts, variant)
+    if scales is not None:
+        ref = ref[:, None] * np.asarray(scales, dtype=np.float64)[None, :]
     diff = np.abs(got - ref)
-    worst = int(np.argmax(diff))
+    worst = np.unravel_index(int(np.argmax(diff)), diff.shape)
     return {
         "points": len(pts),
         "max_abs_diff": float(diff.max()),
         "mean_abs_diff": float(diff.mean()),
+        "max_abs_diff_per_channel": diff.max(axis=0).tolist() if diff.ndim == 2 else None,
         "max_value": float(np.abs(ref).max()),
-        "nonzero_reference_points": int(np.count_nonzero(ref)),
-        "worst_point": pts[worst].tolist(),
+        "nonzero_reference_points": int(np.count_nonzero(ref.reshape(len(pts), -1).max(axis=1))),
+        "worst_point": pts[worst[0]].tolist(),
         "worst_reference": float(ref[worst]),
         "worst_mitsuba": float(got[worst]),
         "reference_seconds": t1 - t0,
@@ -291,6 +347,9 @@ def main(argv=None) -> int:
     ap.add_argument("--grid", default=None, help="grid name (default: density, else the first float grid)")
     ap.add_argument("--check", type=int, default=0, metavar="N",
                     help="evaluate the written grid with Mitsuba at ~1.5N points against OpenVDB trilinear")
+    ap.add_argument("--channel-scales", default=None, metavar="R,G,B",
+                    help="write a 3-channel .vol, channel c = density x this (sigma_t per channel of a chromatic "
+                         "medium, for `scale` 1); --check then compares every channel")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--tolerance", type=float, default=1e-4,
                     help="--check fails when max |mitsuba - openvdb| exceeds this times max(1, max density)")
@@ -299,7 +358,19 @@ def main(argv=None) -> int:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     try:
         t0 = time.time()
-        info = convert(args.vdb, args.vol, args.grid)
+        scales = None
+        if args.channel_scales is not None:
+            scales = [float(v) for v in args.channel_scales.split(",")]
+            if len(scales) != 3:
+                raise ConversionError(f"--channel-scales needs R,G,B, got {args.channel_scales!r}")
+            grey = args.vol + ".grey.tmp"
+            info = convert(args.vdb, grey, args.grid)
+            rgb = scale_channels(grey, args.vol, scales)
+            Path(grey).unlink()
+            print(f"{args.vol}: 3 channels = density x {scales}, max per channel "
+                  f"{[round(v, 6) for v in rgb['max_per_channel']]}")
+        else:
+            info = convert(args.vdb, args.vol, args.grid)
         print(
             f"{args.vol}: grid {info['grid']!r} ({info['transform']}, voxel size {info['voxel_size']}), "
             f"{info['res'][0]}x{info['res'][1]}x{info['res'][2]} samples (active bbox + 1 zero voxel per side), "
@@ -307,13 +378,15 @@ def main(argv=None) -> int:
             f"max {info['max']:.6g}, {time.time() - t0:.2f} s"
         )
         if args.check:
-            r = run_check(info, args.vol, args.check, args.seed, args.variant)
+            r = run_check(info, args.vol, args.check, args.seed, args.variant, scales)
             limit = args.tolerance * max(1.0, r["max_value"])
             print(
                 f"check: {r['points']} points ({r['nonzero_reference_points']} with density > 0): "
                 f"max |mitsuba - openvdb trilinear| = {r['max_abs_diff']:.3g}, mean {r['mean_abs_diff']:.3g} "
                 f"(max density {r['max_value']:.4g}); worst at world {[round(v, 4) for v in r['worst_point']]}: "
                 f"openvdb {r['worst_reference']:.7g} mitsuba {r['worst_mitsuba']:.7g}"
+                + (f"; max per channel R G B {[float(f'{v:.3g}') for v in r['max_abs_diff_per_channel']]}"
+                   if r["max_abs_diff_per_channel"] else "")
             )
             if r["max_abs_diff"] > limit:
                 print(f"check FAILED: difference above {limit:.3g}", file=sys.stderr)
