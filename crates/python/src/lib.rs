@@ -205,9 +205,13 @@ fn render_watched(
             }
             Err(mpsc::RecvTimeoutError::Timeout) => {}
         }
+        // The callback hears of the render once it has a total (not while
+        // the volume loads: (0, 0) would say nothing).
         let checked = py.check_signals().and_then(|()| match &progress {
-            Some(callback) => callback.call1(py, control.progress()).map(drop),
-            None => Ok(()),
+            Some(callback) if control.progress().1 > 0 => {
+                callback.call1(py, control.progress()).map(drop)
+            }
+            _ => Ok(()),
         });
         if let Err(e) = checked {
             control.cancel();

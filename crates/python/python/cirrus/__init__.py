@@ -99,7 +99,7 @@ def render(
     Returns the image as a float32 array (H, W, 4) and the statistics as a
     dict; with ``aov=[...]`` the statistics hold ``"aovs"``, one float32
     (H, W, C) array per layer. ``progress(done, total)`` is called about
-    every 50 ms; if it raises, the render stops and the exception
+    every 50 ms once rendering has begun; if it raises, the render stops and the exception
     propagates, as Ctrl-C does. ``threads`` sets the worker count (the
     image is the same on any count). Outputs named by the overrides
     (``output``, ``png``, ``stats``) or the scene file are written too.
