@@ -191,9 +191,13 @@ def test_errors_are_os_and_value_errors_with_the_cli_message(tmp_path):
 
 
 def test_ctrl_c_stops_a_long_render():
+    # The child installs Python's own SIGINT handler: a shell that starts
+    # a job in the background hands it SIGINT ignored, and Python keeps an
+    # inherited "ignore".
     code = textwrap.dedent(
         f"""
-        import cirrus, sys
+        import cirrus, signal, sys
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         print("start", flush=True)
         try:
             cirrus.render({str(CLOUD)!r}, res="256x256", spp=100000)
@@ -207,7 +211,10 @@ def test_ctrl_c_stops_a_long_render():
     threading.Event().wait(1.0)
     p.send_signal(signal.SIGINT)
     # A hang guard, not a speed check: the full render would take hours.
-    out, _ = p.communicate(timeout=120)
+    try:
+        out, _ = p.communicate(timeout=120)
+    finally:
+        p.kill()
     assert p.returncode == 3 and "interrupted" in out
 
 
