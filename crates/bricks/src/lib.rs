@@ -24,6 +24,7 @@ mod build;
 mod convert;
 mod dda;
 mod dilate;
+mod f16;
 mod format;
 mod layout;
 mod partition;

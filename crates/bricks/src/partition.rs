@@ -117,6 +117,27 @@ impl BrickVolume {
     }
 }
 
+impl BrickVolume {
+    /// The partition a ray march uses: every cell holding density is kept
+    /// at `level` (clamped to the pyramid's levels), never refined by its
+    /// bounds, and no cell is walked voxel by voxel; empty level-1 cells
+    /// keep their distances. A march needs to know only where density is,
+    /// not how tight its bound is, and it looks every lattice point up
+    /// anyway: so a coarse kept cell costs one step for the several lattice
+    /// points inside it, and the lookups it adds are those of the empty
+    /// voxels sharing a kept cell with density, which return at the brick
+    /// map.
+    pub fn occupancy_partition(&self, level: usize) -> CellPartition {
+        let mut p = self.partition(f32::INFINITY, f32::INFINITY);
+        let top = self.levels.len().saturating_sub(1);
+        let code = level.min(top) as u8;
+        for c in p.levels.iter_mut().filter(|c| **c & EMPTY == 0) {
+            *c = code;
+        }
+        p
+    }
+}
+
 /// Replaces the code of every empty level-1 cell by `EMPTY | d`, with `d`
 /// its chessboard distance to the nearest cell with density, capped at 127
 /// (also where the volume has no density at all).

@@ -2,6 +2,7 @@
 //! transform, with the density lookups the renderer calls.
 
 use crate::bounds::BoundsLevel;
+use crate::f16::f16_bits_to_f32;
 use crate::layout::{voxel_offset, BrickRef, Precision, BRICK_LOG2};
 use crate::partition::CellPartition;
 use crate::section::Section;
@@ -129,7 +130,7 @@ impl BrickVolume {
         let i = b as usize * 512 + n;
         match &self.atlas {
             Atlas::F32(a) => a[i],
-            Atlas::F16(a) => half::f16::from_bits(a[i]).to_f32(),
+            Atlas::F16(a) => f16_bits_to_f32(a[i]),
             Atlas::U8(a) => {
                 let (lo, step) = (self.ranges[2 * b as usize], self.ranges[2 * b as usize + 1]);
                 lo + a[i] as f32 * step
@@ -161,8 +162,7 @@ impl BrickVolume {
         let base = b as usize * 512 + n;
         match &self.atlas {
             Atlas::F32(a) => gather!(&a[base..base + 74], |v: f32| v),
-            Atlas::F16(a) => gather!(&a[base..base + 74], |v: u16| half::f16::from_bits(v)
-                .to_f32()),
+            Atlas::F16(a) => gather!(&a[base..base + 74], f16_bits_to_f32),
             Atlas::U8(a) => {
                 let (lo, step) = (self.ranges[2 * b as usize], self.ranges[2 * b as usize + 1]);
                 gather!(&a[base..base + 74], |v: u8| lo + v as f32 * step)
@@ -254,13 +254,54 @@ impl BrickVolume {
     /// (min, max) of the trilinear density over the voxel cell `[c, c + 1)`:
     /// the range of its eight corner voxels.
     pub fn voxel_cell_range(&self, c: IVec3) -> (f32, f32) {
-        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-        for k in 0..8 {
-            let v = self.voxel(c + IVec3::new(k >> 2, (k >> 1) & 1, k & 1));
-            lo = lo.min(v);
-            hi = hi.max(v);
+        let v = if (c & 7).cmplt(IVec3::splat(7)).all() {
+            match self.brick_ref(c >> BRICK_LOG2 as i32) {
+                BrickRef::Empty => return (0.0, 0.0),
+                BrickRef::Constant(k) => {
+                    let v = self.constants[k as usize];
+                    return (v, v);
+                }
+                BrickRef::Stored(b) => self.stored_corners(b, voxel_offset(c.x, c.y, c.z)),
+            }
+        } else {
+            self.straddling_corners(c)
+        };
+        v.iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &x| {
+                (lo.min(x), hi.max(x))
+            })
+    }
+
+    /// The eight voxels `c + {0, 1}^3` (ordered `v[4x + 2y + z]`) of a
+    /// stencil that crosses a brick face: each distinct brick it touches is
+    /// looked up once, two across a face, four at an edge, eight only at a
+    /// corner, where reading the corners one voxel at a time would look a
+    /// brick up eight times.
+    #[inline]
+    fn straddling_corners(&self, c: IVec3) -> [f32; 8] {
+        let b0 = c >> BRICK_LOG2 as i32;
+        let b1 = (c + 1) >> BRICK_LOG2 as i32;
+        // Corner index bits (x 4, y 2, z 1) along which the stencil crosses.
+        let cross = (usize::from(b1.x != b0.x) << 2)
+            | (usize::from(b1.y != b0.y) << 1)
+            | usize::from(b1.z != b0.z);
+        let offset = |k: usize| IVec3::new((k >> 2) as i32, ((k >> 1) & 1) as i32, (k & 1) as i32);
+        let mut bricks = [BrickRef::Empty; 8];
+        for (k, b) in bricks.iter_mut().enumerate() {
+            if k & !cross == 0 {
+                *b = self.brick_ref(b0 + offset(k));
+            }
         }
-        (lo, hi)
+        let mut v = [0.0; 8];
+        for (k, out) in v.iter_mut().enumerate() {
+            let q = c + offset(k);
+            *out = match bricks[k & cross] {
+                BrickRef::Empty => 0.0,
+                BrickRef::Constant(i) => self.constants[i as usize],
+                BrickRef::Stored(b) => self.stored(b, voxel_offset(q.x, q.y, q.z)),
+            };
+        }
+        v
     }
 
     /// Nearest-voxel density at a local index point.
@@ -287,17 +328,7 @@ impl BrickVolume {
                 BrickRef::Stored(b) => self.stored_corners(b, voxel_offset(c.x, c.y, c.z)),
             }
         } else {
-            let at = |dx, dy, dz| self.voxel(c + IVec3::new(dx, dy, dz));
-            [
-                at(0, 0, 0),
-                at(0, 0, 1),
-                at(0, 1, 0),
-                at(0, 1, 1),
-                at(1, 0, 0),
-                at(1, 0, 1),
-                at(1, 1, 0),
-                at(1, 1, 1),
-            ]
+            self.straddling_corners(c)
         };
         // Corners ordered x-major: v[4x + 2y + z].
         let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;

@@ -95,10 +95,17 @@ fn check_ray(
 ) {
     let lo = local(vol, o);
     // The plain walk, a coarse one (cells refined only when their bounds
-    // differ by over 2 density x voxels), and one that goes voxel by voxel.
-    for (split, voxel_split) in [(0.0, f32::INFINITY), (2.0, f32::INFINITY), (0.0, 0.0)] {
-        let cells = vol.partition(split, voxel_split);
-        let segs: Vec<MajorantSegment> = vol.segments_in(&cells, lo, d, t_min, t_max).collect();
+    // differ by over 2 density x voxels), one that goes voxel by voxel, and
+    // the marchers' occupancy cells at levels 1 and 2.
+    let partitions = [
+        vol.partition(0.0, f32::INFINITY),
+        vol.partition(2.0, f32::INFINITY),
+        vol.partition(0.0, 0.0),
+        vol.occupancy_partition(1),
+        vol.occupancy_partition(2),
+    ];
+    for cells in &partitions {
+        let segs: Vec<MajorantSegment> = vol.segments_in(cells, lo, d, t_min, t_max).collect();
         check_segments(tree, o, d, t_min, t_max, samples, &segs);
     }
 }
@@ -409,4 +416,46 @@ fn baselines_bound_the_density_too_and_the_hierarchy_is_tighter() {
         c.tightness < b.tightness && b.tightness < a.tightness,
         "{a:?}\n{b:?}\n{c:?}"
     );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// The marchers' partition keeps every level-1 cell holding density at
+    /// the level asked for (the top one at most) and leaves empty space as
+    /// the refined partition has it, distances included.
+    #[test]
+    fn occupancy_cells_are_the_occupied_cells_at_one_level(seed in 0u64..1000, level in 1usize..4) {
+        let tree = random_tree(seed, IVec3::new(-7, 2, 30));
+        let vol = convert_tree(&tree, Precision::F32).unwrap();
+        let top = vol.levels.len() - 1;
+        let occupancy = vol.occupancy_partition(level);
+        let refined = vol.partition(0.0, f32::INFINITY);
+        let [dx, dy, dz] = vol.levels[1].dims.map(|d| d as i32);
+        let (mut kept, mut empty) = (0, 0);
+        for x in -1..=dx {
+            for y in -1..=dy {
+                for z in -1..=dz {
+                    let c = IVec3::new(x, y, z);
+                    let inside = x >= 0 && y >= 0 && z >= 0 && x < dx && y < dy && z < dz;
+                    let occupied = inside && vol.levels[1].get(c.to_array()).1 > 0.0;
+                    match occupancy.cell_at(c) {
+                        Some(Cell::Kept(l)) => {
+                            prop_assert!(occupied);
+                            prop_assert_eq!(l, level.min(top));
+                            kept += 1;
+                        }
+                        Some(e @ Cell::Empty { .. }) => {
+                            prop_assert!(!occupied);
+                            prop_assert_eq!(Some(e), refined.cell_at(c));
+                            empty += 1;
+                        }
+                        None => prop_assert!(!inside),
+                    }
+                }
+            }
+        }
+        prop_assert_eq!(kept + empty, (dx * dy * dz) as usize);
+        prop_assert!(kept > 0);
+    }
 }

@@ -10,7 +10,7 @@ use cirrus_bricks::{BrickVolume, DBounds3, VelocityGrid};
 use cirrus_render::medium::BrickField;
 use cirrus_render::medium::Extinction;
 use cirrus_render::{
-    Blackbody, DensityField, Phase, Shutter, Velocity, VelocityUnit, VolumeInstance,
+    Blackbody, DensityField, IntegratorKind, Phase, Shutter, Velocity, VelocityUnit, VolumeInstance,
 };
 use cirrus_vdb::VolumeFile;
 use glam::{DMat3, DMat4, DVec3, Vec3};
@@ -289,6 +289,7 @@ impl Files {
         &self,
         p: &Plan,
         centre: DVec3,
+        integrator: IntegratorKind,
         refine: f32,
         shutter: Shutter,
     ) -> Result<VolumeInstance<BrickField<'_>>> {
@@ -311,7 +312,7 @@ impl Files {
                 p.albedo
             )));
         }
-        let density = moved(density.with_refinement(extinction.scale, refine))?;
+        let density = moved(walk_cells(density, integrator, extinction.scale, refine))?;
         let mut inst = VolumeInstance::new(density, extinction.scale, p.albedo, d::G)
             .with_phase(p.phase.clone())
             .with_extinction_tint(extinction.tint);
@@ -387,5 +388,21 @@ mod tests {
                 "{e}"
             );
         }
+    }
+}
+
+/// The cells a density field's walk visits for `integrator`: occupancy
+/// cells for the marchers, majorant cells refined by `refine` (the optical
+/// depth a cell may waste) for the trackers.
+pub(crate) fn walk_cells(
+    field: BrickField<'_>,
+    integrator: IntegratorKind,
+    density_scale: f32,
+    refine: f32,
+) -> BrickField<'_> {
+    if integrator.marches() {
+        field.for_marching()
+    } else {
+        field.with_refinement(density_scale, refine)
     }
 }

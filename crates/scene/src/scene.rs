@@ -225,7 +225,12 @@ impl LoneVolume {
         let camera = camera(s, centre, field.bounds());
         let extinction =
             crate::plan::extinction(&self.spec.file, self.spec.density_scale, field.voxel_size())?;
-        let field = field.with_refinement(extinction.scale, s.refine_optical_depth);
+        let field = crate::plan::walk_cells(
+            field,
+            s.render.integrator,
+            extinction.scale,
+            s.refine_optical_depth,
+        );
         // After the camera: a moving volume is framed as its still frame.
         let field = match &self.velocity {
             Some(v) => field
@@ -361,7 +366,15 @@ fn render_file(
         files.load_grids(p)?;
     }
     let instances = kept()
-        .map(|p| files.instance(p, centre, settings.refine_optical_depth, shutter))
+        .map(|p| {
+            files.instance(
+                p,
+                centre,
+                settings.render.integrator,
+                settings.refine_optical_depth,
+                shutter,
+            )
+        })
         .collect::<Result<Vec<_>>>()?;
     let volumes = Volumes::new(instances);
     if volumes.instances().is_empty() {

@@ -4,7 +4,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::march::{marched_transmittance, MIN_STEP_VOXELS};
+use super::march::{marched_transmittance, ShadowEnd, MIN_STEP_VOXELS};
 use crate::light::Lights;
 use crate::medium::Media;
 use crate::phase::Phase;
@@ -180,7 +180,15 @@ impl LightGrid {
         let p = self.lo + self.cell * Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32);
         let mut e = [0.0; 5];
         if let Some(sun) = &lights.sun {
-            e[0] = marched_transmittance::<M, f32>(medium, p, -sun.direction(), step, rng, c);
+            e[0] = marched_transmittance::<M, f32>(
+                medium,
+                p,
+                -sun.direction(),
+                step,
+                ShadowEnd::Cutoff,
+                rng,
+                c,
+            );
         }
         if lights.environment.is_some() {
             // Directions stratified in cos(theta), random in phi.
@@ -190,7 +198,8 @@ impl LightGrid {
                 let r = (1.0 - z * z).max(0.0).sqrt();
                 let phi = std::f32::consts::TAU * rng.uniform();
                 let w = from_local(Vec3::Z, r * phi.cos(), r * phi.sin(), z);
-                let tr = marched_transmittance::<M, f32>(medium, p, w, step, rng, c);
+                let tr =
+                    marched_transmittance::<M, f32>(medium, p, w, step, ShadowEnd::Cutoff, rng, c);
                 a += tr;
                 b += tr * w;
             }

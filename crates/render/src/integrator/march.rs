@@ -192,32 +192,56 @@ pub(crate) fn march<M: Media, E: Channels>(
     }
 }
 
-/// `exp(-tau)` with `tau` the jittered-march estimate of the optical depth
-/// from `p` toward `dir` (to infinity); counts one shadow ray.
+/// How a marched shadow ray ends inside a dense medium.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ShadowEnd {
+    /// At an optical depth of [`TAU_CUTOFF`]: deterministic, for values
+    /// that are cached and reused (the light grid), where a rouletted
+    /// estimate's noise would be baked in.
+    Cutoff,
+    /// By Russian roulette once the transmittance falls below the
+    /// trackers' threshold ([`roulette`]): unbiased with respect to the
+    /// march, and a ray into a thick cloud stops after an optical depth
+    /// of about 3 (with survivors re-weighted) instead of 30. For shadow
+    /// rays drawn afresh at every step, whose noise averages out.
+    Roulette,
+}
+
+/// The jittered-march estimate of the transmittance from `p` toward `dir`
+/// (to infinity): `exp(-tau)`, ended as `end` says; counts one shadow ray.
 pub(crate) fn marched_transmittance<M: Media, E: Channels>(
     medium: &M,
     p: Vec3,
     dir: Vec3,
     h: f32,
+    end: ShadowEnd,
     rng: &mut Rng,
     c: &mut Counters,
 ) -> E {
     c.shadow_rays += 1;
-    let mut tau = E::ZERO;
     let ray = Ray::new(p, dir);
-    march(
-        medium,
-        &ray,
-        f32::INFINITY,
-        h,
-        rng.uniform(),
-        c,
-        |_, sigma: E, _| {
-            tau = tau.add(sigma.scale(h));
-            tau.min_channel() < TAU_CUTOFF
-        },
-    );
-    tau.exp_neg()
+    let u = rng.uniform();
+    match end {
+        ShadowEnd::Cutoff => {
+            let mut tau = E::ZERO;
+            march(medium, &ray, f32::INFINITY, h, u, c, |_, sigma: E, _| {
+                tau = tau.add(sigma.scale(h));
+                tau.min_channel() < TAU_CUTOFF
+            });
+            tau.exp_neg()
+        }
+        ShadowEnd::Roulette => {
+            let mut tr = E::ONE;
+            march(medium, &ray, f32::INFINITY, h, u, c, |_, sigma: E, _| {
+                if !sigma.any_positive() {
+                    return true;
+                }
+                tr = tr.mul(sigma.scale(h).exp_neg());
+                tr.roulette(rng)
+            });
+            tr
+        }
+    }
 }
 
 /// Marches a camera ray, accumulating single scattering step by step:
@@ -273,5 +297,70 @@ pub(crate) fn march_camera_ray<M: Media, E: Channels>(
         radiance: l,
         alpha: 1.0 - tr.mean(),
         ..Default::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::medium::{GridField, Medium};
+
+    /// Rouletted shadow marches keep the march's mean: from start points
+    /// whose optical depth to the far side runs from about 0.5 to 6.6 (the
+    /// deeper ones rouletted, as they fall below 0.05 on the way), 40,000
+    /// rouletted estimates per point average to the deterministic march
+    /// within 5 standard errors, while looking up far fewer points.
+    #[test]
+    fn rouletted_shadow_marches_keep_the_mean_and_stop_sooner() {
+        // 32^3 voxels of density rising along x; extinction 0.3 per voxel.
+        let field = GridField::from_fn([32, 32, 32], Vec3::ZERO, 1.0, 4, |i, _, _| {
+            0.25 + (i as f32 / 31.0)
+        });
+        let medium = Medium::new(field, 0.3, Vec3::splat(0.9), 0.0);
+        let dir = Vec3::new(1.0, 0.05, -0.02).normalize();
+        let h = 1.5;
+        let mut rng = Rng::new(11, 0, 0);
+        let (mut cutoff_lookups, mut roulette_lookups) = (0u64, 0u64);
+        for x in [2.0, 12.0, 24.0, 30.0] {
+            let p = Vec3::new(x, 16.0, 16.0);
+            let n = 40_000;
+            let (mut exact, mut exact2, mut sum, mut sum2) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+            for _ in 0..n {
+                let mut c = Counters::default();
+                let e: f32 =
+                    marched_transmittance(&medium, p, dir, h, ShadowEnd::Cutoff, &mut rng, &mut c);
+                cutoff_lookups += c.density_lookups;
+                let mut c = Counters::default();
+                let r: f32 = marched_transmittance(
+                    &medium,
+                    p,
+                    dir,
+                    h,
+                    ShadowEnd::Roulette,
+                    &mut rng,
+                    &mut c,
+                );
+                roulette_lookups += c.density_lookups;
+                exact += f64::from(e);
+                exact2 += f64::from(e) * f64::from(e);
+                sum += f64::from(r);
+                sum2 += f64::from(r) * f64::from(r);
+            }
+            let n = f64::from(n);
+            // The cutoff march is itself jittered: its spread counts too.
+            let mean = sum / n;
+            let exact = exact / n;
+            let var = (sum2 / n - mean * mean) / n + (exact2 / n - exact * exact) / n;
+            let se = var.sqrt();
+            assert!(exact > 1e-4, "start {x}: {exact}");
+            assert!(
+                (mean - exact).abs() <= 5.0 * se,
+                "start {x}: rouletted {mean} +- {se}, cutoff {exact}"
+            );
+        }
+        assert!(
+            roulette_lookups * 10 < cutoff_lookups * 8,
+            "{roulette_lookups} vs {cutoff_lookups}"
+        );
     }
 }

@@ -46,6 +46,12 @@ pub enum IntegratorKind {
 }
 
 impl IntegratorKind {
+    /// Whether the integrator marches fixed steps (and so needs only where
+    /// density is, not tight majorants).
+    pub fn marches(self) -> bool {
+        matches!(self, Self::RayMarch | Self::RayMarch2Pass)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Self::Path => "path",

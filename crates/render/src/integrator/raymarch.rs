@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::march::{march_camera_ray, marched_transmittance, Channels};
+use super::march::{march_camera_ray, marched_transmittance, Channels, ShadowEnd};
 use super::{CameraSampler, Sample};
 use crate::light::Lights;
 use crate::medium::Media;
@@ -68,13 +68,28 @@ impl<'a, M: Media> RayMarcher<'a, M> {
             // Sampling the disc uniformly: radiance / pdf is the irradiance.
             let ls = sun.sample(rng.uniform(), rng.uniform());
             let f = phase.eval(dir, ls.to_light);
-            let tr: E =
-                marched_transmittance(self.medium, p, ls.to_light, self.shadow_step, rng, c);
+            let tr: E = marched_transmittance(
+                self.medium,
+                p,
+                ls.to_light,
+                self.shadow_step,
+                ShadowEnd::Roulette,
+                rng,
+                c,
+            );
             s += tr.scale(f).tint(sun.irradiance());
         }
         if let Some(env) = &self.lights.environment {
             let (w, _) = phase.sample(dir, rng.uniform(), rng.uniform());
-            let tr: E = marched_transmittance(self.medium, p, w, self.shadow_step, rng, c);
+            let tr: E = marched_transmittance(
+                self.medium,
+                p,
+                w,
+                self.shadow_step,
+                ShadowEnd::Roulette,
+                rng,
+                c,
+            );
             c.env_samples += 1;
             s += tr.tint(env.eval(w).0);
         }
