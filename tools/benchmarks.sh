@@ -51,12 +51,7 @@ PY
 )"
 
 section "Ray marching against OpenVDB's vdb_render (same file, resolution, view, step)"
-t0=$(date +%s.%N); vdb_render data/cloud.vdb "$out/vdb_render.png" -res 512x512 -translate 150,83,-250 -lookat 150,83,100 -fov 40 -light 0.7,-0.5,0.5,1,1,1 -step 1 -shadowstep 3 >/dev/null 2>&1; t1=$(date +%s.%N)
-$cirrus render data/cloud.vdb -o "$out/rm.exr" --res 512x512 --spp 1 --integrator raymarch --step 1 --shadow-step 3 "${cam[@]}" --sun-angle 0 --env-radiance 0,0,0 --density-scale 1.6 >/dev/null 2>&1; t2=$(date +%s.%N)
-code "$(python3 -c "
-a=$t1-$t0; b=$t2-$t1
-print(f'vdb_render  step 1, shadow step 3, sigma 1.6/voxel: {a:.2f} s')
-print(f'cirrus raymarch step 1, shadow step 3, sigma 1.6/voxel, sun only: {b:.2f} s  = {b/a:.2f} x vdb_render')")"
+code "$(bash tools/bench_vdb_render.sh 3 1 8)"
 
 section "Run time against error"
 $cirrus bench error data/cloud.vdb --res $res "${cam[@]}" --budgets $budgets --reference-time $reftime --out "$out/error" > /dev/null 2>"$out/error.log"

@@ -64,6 +64,8 @@ enum Structure {
     Hierarchy,
     Fixed,
     Global,
+    /// The hierarchy or the global bound, as `MajorantMode::Auto` chooses.
+    Auto,
 }
 
 impl Structure {
@@ -72,6 +74,7 @@ impl Structure {
             Structure::Hierarchy => "hierarchy",
             Structure::Fixed => "fixed grid",
             Structure::Global => "global",
+            Structure::Auto => "automatic",
         }
     }
 }
@@ -145,6 +148,11 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
             Structure::Hierarchy,
         )
     };
+    v.push(Config {
+        name: "automatic structure: delta + residual".into(),
+        structure: Structure::Auto,
+        ..default("")
+    });
     v.push(Config {
         sampler: SamplerKind::Random,
         ..default("random numbers")
@@ -249,10 +257,10 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
     let settings_for = |c: &Config, budget: Budget, seed: u64| RenderSettings {
         integrator: c.integrator,
         transmittance: c.transmittance,
-        majorant: if c.structure == Structure::Global {
-            MajorantMode::Global
-        } else {
-            MajorantMode::Hierarchy
+        majorant: match c.structure {
+            Structure::Global => MajorantMode::Global,
+            Structure::Auto => MajorantMode::Auto,
+            Structure::Hierarchy | Structure::Fixed => MajorantMode::Hierarchy,
         },
         budget,
         seed,

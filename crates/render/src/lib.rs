@@ -48,6 +48,7 @@ pub mod film;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
+pub mod majorant_choice;
 pub mod medium;
 pub mod phase;
 pub mod ray;

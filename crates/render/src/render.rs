@@ -15,6 +15,7 @@ use crate::integrator::{
     CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
 };
 use crate::light::Lights;
+use crate::majorant_choice;
 use crate::medium::{DensityField, GlobalMedia, Media};
 use crate::sampling::{Draw, SampleStream, SamplerKind};
 use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
@@ -67,12 +68,19 @@ pub fn render_media<M: Media>(
     settings: &RenderSettings,
 ) -> Rendered {
     let start = Instant::now();
-    match settings.majorant {
-        MajorantMode::Hierarchy => render_with(media, camera, lights, settings, start),
+    let (mode, probe) = majorant_choice::choose(media, camera, lights, settings);
+    let mut r = match mode {
         MajorantMode::Global => {
             render_with(&GlobalMedia::new(media), camera, lights, settings, start)
         }
-    }
+        _ => render_with(media, camera, lights, settings, start),
+    };
+    r.stats.majorant = match settings.majorant {
+        MajorantMode::Auto => format!("auto: {}", mode.name()),
+        _ => mode.name().into(),
+    };
+    r.stats.majorant_probe = probe.map(|[local, global]| [local.cost(), global.cost()]);
+    r
 }
 
 fn render_with<M: Media>(

@@ -27,7 +27,12 @@ pub struct Scene<F> {
 #[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum MajorantMode {
-    /// The field's own local segments (its hierarchy or grid).
+    /// Whichever of the two a probe of the scene finds cheaper
+    /// ([`crate::majorant_choice`]); the scene crate's default.
+    Auto,
+    /// The field's own local segments (its hierarchy or grid); what
+    /// [`RenderSettings::default`] walks, so that a render's structure is
+    /// fixed unless asked to be chosen.
     #[default]
     Hierarchy,
     /// One global majorant over the field's bounds (Mitsuba 3 style).
@@ -37,6 +42,7 @@ pub enum MajorantMode {
 impl MajorantMode {
     pub fn name(self) -> &'static str {
         match self {
+            Self::Auto => "auto",
             Self::Hierarchy => "hierarchy",
             Self::Global => "global",
         }

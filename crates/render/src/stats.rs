@@ -73,7 +73,13 @@ impl std::ops::Add for Counters {
 pub struct RenderStats {
     pub integrator: String,
     pub transmittance: String,
+    /// The majorant structure walked; with `auto`, the one chosen
+    /// ("auto: global").
     pub majorant: String,
+    /// With `auto` and the path tracer: the probe's costs over the
+    /// hierarchy and the global bound, in tentative collisions
+    /// ([`crate::majorant_choice`]).
+    pub majorant_probe: Option<[f64; 2]>,
     pub width: u32,
     pub height: u32,
     /// Samples per pixel actually taken (with a time budget: reached).

@@ -41,7 +41,10 @@ pub const SAMPLER: SamplerKind = SamplerKind::Sobol;
 /// Samples a pixel takes before adaptive sampling may stop it.
 pub const MIN_SPP: u32 = 16;
 pub const TRANSMITTANCE: TransmittanceEstimator = TransmittanceEstimator::Residual;
-pub const MAJORANT: MajorantMode = MajorantMode::Hierarchy;
+/// The path tracer probes both structures on the scene and takes the
+/// cheaper (`cirrus_render::majorant_choice`); the marchers walk the
+/// hierarchy's cells.
+pub const MAJORANT: MajorantMode = MajorantMode::Auto;
 /// Majorant cells are refined while crossing one would cost more than this
 /// many extra null collisions (Blender Cycles uses 1.442).
 pub const REFINE_OPTICAL_DEPTH: f32 = 1.0;

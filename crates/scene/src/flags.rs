@@ -130,8 +130,9 @@ pub struct SceneFlags {
     /// Shadow-ray transmittance estimator [default: residual].
     #[arg(long, value_enum)]
     pub transmittance: Option<TransmittanceEstimator>,
-    /// Majorants for tracking: the brick hierarchy, or one global majorant
-    /// (Mitsuba-like) [default: hierarchy].
+    /// Majorants for tracking: the brick hierarchy, one global majorant
+    /// (Mitsuba-like), or whichever a probe of the scene finds cheaper
+    /// [default: auto].
     #[arg(long, value_enum)]
     pub majorant: Option<MajorantMode>,
     /// Majorant cells are refined while crossing one would cost more than

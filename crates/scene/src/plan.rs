@@ -362,6 +362,22 @@ pub(crate) fn extinction(
     Ok(Extinction::split(rgb))
 }
 
+/// The cells a density field's walk visits for `integrator`: occupancy
+/// cells for the marchers, majorant cells refined by `refine` (the optical
+/// depth a cell may waste) for the trackers.
+pub(crate) fn walk_cells(
+    field: BrickField<'_>,
+    integrator: IntegratorKind,
+    density_scale: f32,
+    refine: f32,
+) -> BrickField<'_> {
+    if integrator.marches() {
+        field.for_marching()
+    } else {
+        field.with_refinement(density_scale, refine)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -388,21 +404,5 @@ mod tests {
                 "{e}"
             );
         }
-    }
-}
-
-/// The cells a density field's walk visits for `integrator`: occupancy
-/// cells for the marchers, majorant cells refined by `refine` (the optical
-/// depth a cell may waste) for the trackers.
-pub(crate) fn walk_cells(
-    field: BrickField<'_>,
-    integrator: IntegratorKind,
-    density_scale: f32,
-    refine: f32,
-) -> BrickField<'_> {
-    if integrator.marches() {
-        field.for_marching()
-    } else {
-        field.with_refinement(density_scale, refine)
     }
 }
