@@ -393,8 +393,7 @@ fn collision_cost_ns(medium: &Medium<BrickField>) -> f64 {
                     let mut rng = Rng::new(0xC0_111DE, k, 0);
                     let u = glam::Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
                     let origin = lo + (hi - lo) * u;
-                    let dir =
-                        cirrus_render::sampling::uniform_sphere(rng.uniform(), rng.uniform());
+                    let dir = cirrus_render::sampling::uniform_sphere(rng.uniform(), rng.uniform());
                     let ray = Ray::new(origin, dir);
                     std::hint::black_box(sample_free_flight(
                         &global,

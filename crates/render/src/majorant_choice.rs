@@ -27,6 +27,7 @@ use crate::sampling::Rng;
 use crate::scene::{MajorantMode, RenderSettings};
 use crate::stats::Counters;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Paths traced over each structure, in parallel chunks of
 /// [`PROBE_CHUNK`]. On the corpus cloud the probe takes about 20 ms
@@ -55,6 +56,13 @@ pub struct ProbeCost {
 }
 
 impl ProbeCost {
+    fn of(c: &Counters) -> Self {
+        ProbeCost {
+            lookups: c.density_lookups,
+            segments: c.dda_segments,
+        }
+    }
+
     /// In tentative collisions.
     pub fn cost(self) -> f64 {
         self.lookups as f64 + SEGMENT_COST * self.segments as f64
@@ -73,8 +81,20 @@ pub fn choose<M: Media>(
 ) -> (MajorantMode, Option<[ProbeCost; 2]>) {
     match settings.majorant {
         MajorantMode::Auto if settings.integrator == crate::IntegratorKind::Path => {
-            let local = probe(media, camera, lights, settings);
-            let global = probe(&GlobalMedia::new(media), camera, lights, settings);
+            let local = probe(media, camera, lights, settings, f64::INFINITY);
+            // The global probe stops once it has cost more than the whole
+            // hierarchy probe: it has lost, and a global bound far above
+            // most of the density (one dense voxel in a large empty box)
+            // would otherwise take up to the trackers' collision cap on
+            // every ray. Its figure is then a lower bound; the choice is
+            // the same however the chunks were scheduled.
+            let global = probe(
+                &GlobalMedia::new(media),
+                camera,
+                lights,
+                settings,
+                local.cost(),
+            );
             let mode = if global.cost() < local.cost() {
                 MajorantMode::Global
             } else {
@@ -87,12 +107,14 @@ pub fn choose<M: Media>(
     }
 }
 
-/// Lookups and segments of [`PROBE_PATHS`] paths over `media`.
+/// Lookups and segments of [`PROBE_PATHS`] paths over `media`, or of
+/// those traced before their cost passed `limit`.
 fn probe<M: Media>(
     media: &M,
     camera: &Camera,
     lights: &Lights,
     settings: &RenderSettings,
+    limit: f64,
 ) -> ProbeCost {
     let tracer = PathTracer::new(
         media,
@@ -103,22 +125,29 @@ fn probe<M: Media>(
     let (w, h) = (camera.width().max(1), camera.height().max(1));
     let pixels = u64::from(w) * u64::from(h);
     // Each path has its own numbers and counts add, so the sum is the same
-    // however the chunks are scheduled.
+    // however the chunks are scheduled (unless the limit stops it).
+    let spent = AtomicU64::new(0);
     (0..PROBE_PATHS / PROBE_CHUNK)
         .into_par_iter()
         .map(|chunk| {
             let mut c = Counters::default();
             for i in chunk * PROBE_CHUNK..(chunk + 1) * PROBE_CHUNK {
+                if f64::from_bits(spent.load(Ordering::Relaxed)) > limit {
+                    break;
+                }
+                let before = ProbeCost::of(&c).cost();
                 let mut rng = Rng::new(PROBE_SEED, u64::from(i), 0);
                 let pixel = (rng.next_u64() % pixels) as u32;
                 let (x, y) = (pixel % w, pixel / w);
                 let ray = camera.ray(x as f32 + rng.uniform(), y as f32 + rng.uniform());
                 tracer.sample(ray, &mut rng, &mut c);
+                let path = ProbeCost::of(&c).cost() - before;
+                // A float sum in an atomic: only compared with the limit.
+                let _ = spent.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |bits| {
+                    Some((f64::from_bits(bits) + path).to_bits())
+                });
             }
-            ProbeCost {
-                lookups: c.density_lookups,
-                segments: c.dda_segments,
-            }
+            ProbeCost::of(&c)
         })
         .reduce(ProbeCost::default, |a, b| ProbeCost {
             lookups: a.lookups + b.lookups,

@@ -86,3 +86,30 @@ fn marchers_never_probe_and_walk_the_hierarchy() {
     assert_eq!(r.stats.majorant, "auto: hierarchy");
     assert!(r.stats.majorant_probe.is_none());
 }
+
+/// One very dense voxel in a large empty box: a global bound puts about
+/// 40,000 null collisions on every ray through the box, so probing it in
+/// full would cost some 10^8 lookups. The probe stops the global side once
+/// it has cost more than the whole hierarchy probe, and takes the
+/// hierarchy.
+#[test]
+fn the_global_probe_stops_once_it_has_lost() {
+    let field = GridField::from_fn([64, 64, 64], Vec3::ZERO, 1.0 / 64.0, 4, |i, j, k| {
+        if (i, j, k) == (60, 60, 60) {
+            1.0e4
+        } else {
+            0.0
+        }
+    });
+    let lights = lights();
+    let scene = common::scene(common::medium(field, 4.0, 0.9, 0.3), 8, lights);
+    let mut s = common::settings(IntegratorKind::Path, 1, 3);
+    s.majorant = MajorantMode::Auto;
+    let r = render(&scene, &s);
+    assert_eq!(r.stats.majorant, "auto: hierarchy");
+    let [local, global] = r.stats.majorant_probe.unwrap();
+    // Stopped past `local`, with at most a few paths in flight (each path
+    // here costs on the order of 10^5).
+    assert!(global > local, "{global} vs {local}");
+    assert!(global < local + 2.0e6, "{global} vs {local}");
+}
