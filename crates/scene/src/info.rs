@@ -146,25 +146,8 @@ struct RangeSink<'a> {
 impl RangeSink<'_> {
     #[inline]
     fn add(&mut self, c: [f64; 3], k: usize) {
-        if c[..k].iter().any(|x| x.is_nan()) {
+        if !ValueRange::include(&mut self.range, c, k) {
             self.nan += 1;
-            return;
-        }
-        match &mut self.range {
-            None => {
-                self.range = Some(ValueRange {
-                    min: c,
-                    max: c,
-                    components: k,
-                    nan_count: 0,
-                })
-            }
-            Some(r) => {
-                for (i, &x) in c.iter().enumerate().take(k) {
-                    r.min[i] = r.min[i].min(x);
-                    r.max[i] = r.max[i].max(x);
-                }
-            }
         }
     }
 }

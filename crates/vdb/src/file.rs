@@ -132,15 +132,23 @@ impl VolumeFile {
         self.source.len()
     }
 
+    /// `Ok` when the file has a grid `index`, else an error naming the
+    /// file and how many grids it has.
+    fn check_index(&self, index: usize) -> Result<()> {
+        let count = self.grids().len();
+        if index >= count {
+            return Err(Error::new(
+                self.path(),
+                ErrorKind::NoSuchGrid(format!("#{index} (the file has {count})")),
+            ));
+        }
+        Ok(())
+    }
+
     /// Reads grid `index` (file order).
     pub fn read_grid(&self, index: usize) -> Result<Grid> {
         let err = |kind: ErrorKind| Error::new(self.path(), kind);
-        let count = self.grids().len();
-        if index >= count {
-            return Err(err(ErrorKind::NoSuchGrid(format!(
-                "#{index} (the file has {count})"
-            ))));
-        }
+        self.check_index(index)?;
         match &self.index {
             Index::OpenVdb(a) => a.read_grid(&self.source, index),
             Index::NanoVdb(n) => n.read_grid(&self.source, index),
@@ -154,12 +162,7 @@ impl VolumeFile {
     /// written without `file_bbox_min` / `file_bbox_max` metadata).
     pub fn grid_bounds(&self, index: usize) -> Result<Option<GridBounds>> {
         let err = |kind: ErrorKind| Error::new(self.path(), kind);
-        let count = self.grids().len();
-        if index >= count {
-            return Err(err(ErrorKind::NoSuchGrid(format!(
-                "#{index} (the file has {count})"
-            ))));
-        }
+        self.check_index(index)?;
         let Index::OpenVdb(a) = &self.index else {
             return Ok(None);
         };
@@ -178,12 +181,7 @@ impl VolumeFile {
     /// sits inside the (possibly compressed) grid buffer.
     pub fn grid_header(&self, index: usize) -> Result<Option<GridHeader>> {
         let err = |kind: ErrorKind| Error::new(self.path(), kind);
-        let count = self.grids().len();
-        if index >= count {
-            return Err(err(ErrorKind::NoSuchGrid(format!(
-                "#{index} (the file has {count})"
-            ))));
-        }
+        self.check_index(index)?;
         let Index::OpenVdb(a) = &self.index else {
             return Ok(None);
         };
@@ -224,12 +222,7 @@ impl VolumeFile {
     /// leaf values and not into a tree. See [`GridStream::decode_leaves`].
     pub fn stream_grid<V: Value>(&self, index: usize) -> Result<GridStream<'_, V>> {
         let err = |kind: ErrorKind| Error::new(self.path(), kind);
-        let count = self.grids().len();
-        if index >= count {
-            return Err(err(ErrorKind::NoSuchGrid(format!(
-                "#{index} (the file has {count})"
-            ))));
-        }
+        self.check_index(index)?;
         match &self.index {
             Index::OpenVdb(a) => a.stream_grid(&self.source, index).map_err(err),
             Index::NanoVdb(_) => Err(err(unsupported("streaming a NanoVDB grid"))),

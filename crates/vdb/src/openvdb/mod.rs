@@ -118,6 +118,22 @@ impl Archive {
         })
     }
 
+    /// The index of the grid whose tree instance `entry` shares: the
+    /// non-instance grid named by its `instance_parent`.
+    pub(crate) fn instance_parent(&self, entry: &GridEntry) -> KindResult<usize> {
+        self.grids
+            .iter()
+            .position(|g| {
+                g.info.unique_name == entry.instance_parent && g.instance_parent.is_empty()
+            })
+            .ok_or_else(|| {
+                corrupt(format!(
+                    "instance of missing grid {:?}",
+                    entry.instance_parent
+                ))
+            })
+    }
+
     /// Reads grid `index`: its metadata, transform and tree.
     pub fn read_grid(&self, src: &FileSource, index: usize) -> KindResult<Grid> {
         let entry = &self.grids[index];
@@ -137,19 +153,7 @@ impl Archive {
             read_grid_tree(&mut cur, vt, compression, entry.info.half_float)?
         } else {
             // An instance shares its parent's tree; its own record stops after the transform.
-            let parent = self
-                .grids
-                .iter()
-                .position(|g| {
-                    g.info.unique_name == entry.instance_parent && g.instance_parent.is_empty()
-                })
-                .ok_or_else(|| {
-                    corrupt(format!(
-                        "instance of missing grid {:?}",
-                        entry.instance_parent
-                    ))
-                })?;
-            self.read_grid(src, parent)?.tree
+            self.read_grid(src, self.instance_parent(entry)?)?.tree
         };
         Ok(Grid {
             name: entry.info.name.clone(),

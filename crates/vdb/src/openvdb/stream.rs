@@ -470,18 +470,7 @@ impl Archive {
         let mut half = entry.info.half_float;
         if !entry.instance_parent.is_empty() {
             // An instance shares its parent's tree; stream the parent's record.
-            let parent = self
-                .grids
-                .iter()
-                .find(|g| {
-                    g.info.unique_name == entry.instance_parent && g.instance_parent.is_empty()
-                })
-                .ok_or_else(|| {
-                    corrupt(format!(
-                        "instance of missing grid {:?}",
-                        entry.instance_parent
-                    ))
-                })?;
+            let parent = &self.grids[self.instance_parent(entry)?];
             win = Window::new(src, parent.grid_pos, parent.end_pos);
             compression = grid_header(&mut win)?.0;
             end = parent.end_pos;
@@ -531,18 +520,7 @@ impl Archive {
         let mut win = Window::new(src, entry.grid_pos, entry.end_pos);
         let (_, metadata, transform) = grid_header(&mut win)?;
         if !entry.instance_parent.is_empty() {
-            entry = self
-                .grids
-                .iter()
-                .find(|g| {
-                    g.info.unique_name == entry.instance_parent && g.instance_parent.is_empty()
-                })
-                .ok_or_else(|| {
-                    corrupt(format!(
-                        "instance of missing grid {:?}",
-                        entry.instance_parent
-                    ))
-                })?;
+            entry = &self.grids[self.instance_parent(entry)?];
             win = Window::new(src, entry.grid_pos, entry.end_pos);
             grid_header(&mut win)?;
         }

@@ -30,6 +30,35 @@ pub struct ValueRange {
     pub nan_count: u64,
 }
 
+impl ValueRange {
+    /// Widens `range` (`None` before the first value) to the first `k`
+    /// components of `c`; returns false, leaving it alone, for a value
+    /// with a NaN component, which the caller counts.
+    #[inline]
+    pub fn include(range: &mut Option<ValueRange>, c: [f64; 3], k: usize) -> bool {
+        if c[..k].iter().any(|x| x.is_nan()) {
+            return false;
+        }
+        match range {
+            None => {
+                *range = Some(ValueRange {
+                    min: c,
+                    max: c,
+                    components: k,
+                    nan_count: 0,
+                })
+            }
+            Some(r) => {
+                for (i, &x) in c.iter().enumerate().take(k) {
+                    r.min[i] = r.min[i].min(x);
+                    r.max[i] = r.max[i].max(x);
+                }
+            }
+        }
+        true
+    }
+}
+
 impl<V: Value> Tree<V> {
     /// Active voxels, with every active tile counted at its full volume.
     pub fn active_voxel_count(&self) -> u64 {
@@ -80,25 +109,8 @@ impl<V: Value> Tree<V> {
         let mut nan = 0u64;
         let mut add = |v: V| {
             let (c, k) = v.components();
-            if c[..k].iter().any(|x| x.is_nan()) {
+            if !ValueRange::include(&mut r, c, k) {
                 nan += 1;
-                return;
-            }
-            match &mut r {
-                None => {
-                    r = Some(ValueRange {
-                        min: c,
-                        max: c,
-                        components: k,
-                        nan_count: 0,
-                    })
-                }
-                Some(r) => {
-                    for (i, &x) in c.iter().enumerate().take(k) {
-                        r.min[i] = r.min[i].min(x);
-                        r.max[i] = r.max[i].max(x);
-                    }
-                }
             }
         };
         for leaf in &self.leaves {
