@@ -303,6 +303,7 @@ fn kept_levels(levels: &[BoundsLevel], split: f32) -> Vec<u8> {
 mod tests {
     use super::*;
     use crate::bounds::build_pyramid;
+    use cirrus_testkit::SplitMix64;
 
     /// The 13 neighbours that come before a cell in x-major order.
     const HALF_NEIGHBOURS: [(i32, i32, i32); 13] = [
@@ -416,35 +417,21 @@ mod tests {
         table
     }
 
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-            z ^ (z >> 31)
-        }
-        fn unit(&mut self) -> f32 {
-            (self.next() >> 40) as f32 / (1u64 << 24) as f32
-        }
-    }
-
     #[test]
     fn parallel_passes_equal_the_recursive_walk_and_the_chamfer_transform() {
-        let mut rng = Rng(7);
+        let mut rng = SplitMix64(7);
         let mut checked = 0;
         for case in 0..60 {
             // Level-0 grids of every small shape, from empty to dense, with
             // runs longer than the distance cap in the larger ones.
             let dims = if case < 50 {
                 [
-                    1 + rng.next() % 40,
-                    1 + rng.next() % 40,
-                    1 + rng.next() % 40,
+                    1 + rng.next_u64() % 40,
+                    1 + rng.next_u64() % 40,
+                    1 + rng.next_u64() % 40,
                 ]
             } else {
-                [600, 3 + rng.next() % 4, 2 + rng.next() % 5]
+                [600, 3 + rng.next_u64() % 4, 2 + rng.next_u64() % 5]
             }
             .map(|d| d as u32);
             let fill = [0.0, 0.001, 0.02, 0.2, 0.7][case % 5];
@@ -480,14 +467,14 @@ mod tests {
 
     #[test]
     fn the_line_transform_is_the_brute_force_minimum() {
-        let mut rng = Rng(3);
+        let mut rng = SplitMix64(3);
         let (mut left, mut stack) = (Vec::new(), Vec::new());
         for _ in 0..2000 {
-            let n = 1 + (rng.next() % 300) as usize;
+            let n = 1 + (rng.next_u64() % 300) as usize;
             let g: Vec<u8> = (0..n)
                 .map(|_| {
-                    if rng.next() & 3 == 0 {
-                        (rng.next() % 128) as u8
+                    if rng.next_u64() & 3 == 0 {
+                        (rng.next_u64() % 128) as u8
                     } else {
                         CAP
                     }

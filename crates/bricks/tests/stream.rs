@@ -7,20 +7,14 @@
 //! refuses, `convert_file` refuses with the same words.
 
 use cirrus_bricks::{convert, convert_file, write_cbrk, BrickError, BrickVolume, Precision};
+use cirrus_testkit::{mutate_past_header, SplitMix64};
 use cirrus_vdb::{ValueType, VolumeFile};
 use glam::IVec3;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 fn corpus() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "vdb" || e == "nvdb"))
-        .collect();
-    files.sort();
-    files
+    cirrus_testkit::corpus(&["vdb", "nvdb"], None)
 }
 
 fn cbrk_bytes(v: &BrickVolume, dir: &Path, name: &str) -> Vec<u8> {
@@ -161,20 +155,6 @@ fn refusals_name_the_grid_and_what_is_wrong() {
     assert!(msg("other_types.vdb", "ids").contains("int32"));
 }
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
-
 #[test]
 fn mutated_files_convert_or_fail_naming_the_file_never_panic() {
     let files: Vec<PathBuf> = corpus()
@@ -188,22 +168,12 @@ fn mutated_files_convert_or_fail_naming_the_file_never_panic() {
         .collect();
     let dir = std::env::temp_dir().join(format!("cirrus-stream-bricks-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let mut rng = Rng(5);
+    let mut rng = SplitMix64(5);
     let (mut errors, mut converted) = (0, 0);
     for round in 0..1500 {
         let src = &files[rng.below(files.len())];
         let mut bytes = std::fs::read(src).unwrap();
-        for _ in 0..1 + rng.below(3) {
-            if bytes.len() <= 61 {
-                break;
-            }
-            let i = 60 + rng.below(bytes.len() - 60);
-            match rng.below(3) {
-                0 => bytes[i] ^= 1 << rng.below(8),
-                1 => bytes[i] = rng.next() as u8,
-                _ => bytes.truncate(i),
-            }
-        }
+        mutate_past_header(&mut rng, &mut bytes, 3);
         let path = dir.join(format!("m{round}.vdb"));
         std::fs::write(&path, &bytes).unwrap();
         let result = catch_unwind(AssertUnwindSafe(|| -> Result<(), String> {

@@ -5,17 +5,10 @@
 use cirrus_scene::info::file_report_with;
 use cirrus_vdb::{GridTree, VolumeFile};
 use serde_json::{json, Value as Json};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn corpus() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "vdb" || e == "nvdb"))
-        .collect();
-    files.sort();
-    files
+    cirrus_testkit::corpus(&["vdb", "nvdb"], None)
 }
 
 fn num(v: f64) -> Json {

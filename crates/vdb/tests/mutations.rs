@@ -3,6 +3,7 @@
 //! a panic. An abort (an allocation the file cannot justify) would end the
 //! test process, so it fails too.
 
+use cirrus_testkit::SplitMix64;
 use cirrus_vdb::VolumeFile;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
@@ -10,36 +11,9 @@ use std::path::{Path, PathBuf};
 /// Mutations per run: at least 10,000 across the corpus.
 const MUTATIONS: usize = 12_000;
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        // SplitMix64: seeded, so every run mutates the same bytes.
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
-
+/// Small files keep 12,000 loads fast; they cover every codec and layout.
 fn corpus_files() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("data/ exists")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "vdb" || e == "nvdb"))
-        // Small files keep 12,000 loads fast; they cover every codec and layout.
-        .filter(|p| {
-            std::fs::metadata(p)
-                .map(|m| m.len() < 400_000)
-                .unwrap_or(false)
-        })
-        .collect();
-    files.sort();
-    files
+    cirrus_testkit::corpus(&["vdb", "nvdb"], Some(400_000))
 }
 
 /// Opens and reads every grid; returns whether it loaded. Panics propagate.
@@ -51,7 +25,7 @@ fn load(path: &Path) -> Result<usize, String> {
     Ok(f.grids().len())
 }
 
-fn mutate(rng: &mut Rng, bytes: &mut Vec<u8>) {
+fn mutate(rng: &mut SplitMix64, bytes: &mut Vec<u8>) {
     match rng.below(6) {
         0 => {
             let i = rng.below(bytes.len());
@@ -60,13 +34,13 @@ fn mutate(rng: &mut Rng, bytes: &mut Vec<u8>) {
         1 => {
             for _ in 0..1 + rng.below(16) {
                 let i = rng.below(bytes.len());
-                bytes[i] = rng.next() as u8;
+                bytes[i] = rng.next_u64() as u8;
             }
         }
         2 if bytes.len() >= 8 => {
             // A size or offset field gone wild.
             let i = rng.below(bytes.len().saturating_sub(8));
-            let v = [u64::MAX, 1 << 40, 1 << 31, rng.next(), 0][rng.below(5)];
+            let v = [u64::MAX, 1 << 40, 1 << 31, rng.next_u64(), 0][rng.below(5)];
             bytes[i..i + 8].copy_from_slice(&v.to_le_bytes());
         }
         3 => bytes.truncate(rng.below(bytes.len())),
@@ -77,7 +51,9 @@ fn mutate(rng: &mut Rng, bytes: &mut Vec<u8>) {
         }
         _ => {
             let i = rng.below(bytes.len());
-            let fill: Vec<u8> = (0..1 + rng.below(64)).map(|_| rng.next() as u8).collect();
+            let fill: Vec<u8> = (0..1 + rng.below(64))
+                .map(|_| rng.next_u64() as u8)
+                .collect();
             bytes.splice(i..i, fill);
         }
     }
@@ -94,7 +70,7 @@ fn mutated_corpus_files_error_cleanly_and_never_panic() {
     let dir = std::env::temp_dir().join(format!("cirrus-mutations-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let target = dir.join("mutant.vdb");
-    let mut rng = Rng(0xC1_22_05);
+    let mut rng = SplitMix64(0xC1_22_05);
     let (mut loaded, mut refused, mut panicked) = (0, 0, Vec::new());
     for k in 0..MUTATIONS {
         let src = &files[k % files.len()];
@@ -140,8 +116,8 @@ fn empty_random_and_truncated_files_are_clear_errors() {
         .expect("empty file must fail")
         .to_string();
     assert!(e.contains("bad.vdb") && e.contains("ends early"), "{e}");
-    let mut rng = Rng(42);
-    let random: Vec<u8> = (0..4096).map(|_| rng.next() as u8).collect();
+    let mut rng = SplitMix64(42);
+    let random: Vec<u8> = (0..4096).map(|_| rng.next_u64() as u8).collect();
     std::fs::write(&p, &random).unwrap();
     let e = VolumeFile::open(&p)
         .err()

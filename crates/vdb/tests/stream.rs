@@ -4,6 +4,7 @@
 //! counts, bounds and memory figure; and bad input is an error naming the
 //! file, never a panic.
 
+use cirrus_testkit::{mutate_past_header, SplitMix64};
 use cirrus_vdb::{
     BitMask, DecodeError, Format, GridTree, LeafSink, Tree, Value, ValueType, VolumeFile,
 };
@@ -12,14 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 fn corpus() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "vdb"))
-        .collect();
-    files.sort();
-    files
+    cirrus_testkit::corpus(&["vdb"], None)
 }
 
 /// Leaves by index: mask and values.
@@ -184,20 +178,6 @@ fn grid_headers_are_read_without_the_tree() {
     assert!(nvdb.stream_grid::<f32>(0).is_err());
 }
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
-
 /// Counts leaves and nothing else.
 struct Count;
 impl LeafSink<f32> for Count {
@@ -222,23 +202,13 @@ fn mutated_files_stream_to_errors_naming_the_file_never_panics() {
         .collect();
     let dir = std::env::temp_dir().join(format!("cirrus-stream-mut-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let mut rng = Rng(99);
+    let mut rng = SplitMix64(99);
     let (mut errors, mut loaded) = (0, 0);
     for round in 0..3000 {
         let src = &files[rng.below(files.len())];
         let mut bytes = std::fs::read(src).unwrap();
         // Mutate past the header, where the trees are.
-        for _ in 0..1 + rng.below(4) {
-            if bytes.len() <= 61 {
-                break;
-            }
-            let i = 60 + rng.below(bytes.len() - 60);
-            match rng.below(3) {
-                0 => bytes[i] ^= 1 << rng.below(8),
-                1 => bytes[i] = rng.next() as u8,
-                _ => bytes.truncate(i),
-            }
-        }
+        mutate_past_header(&mut rng, &mut bytes, 4);
         let path = dir.join(format!("m{round}.vdb"));
         std::fs::write(&path, &bytes).unwrap();
         let result = catch_unwind(AssertUnwindSafe(|| -> Result<(), String> {
