@@ -44,27 +44,96 @@ use crate::bounds::CELL_LOG2;
 use crate::partition::{Cell, CellPartition};
 use crate::segment::MajorantSegment;
 use crate::volume::BrickVolume;
-use glam::Vec3;
+use glam::{IVec3, Vec3};
 
 /// A cell with `minorant >= TIGHT_ENOUGH * majorant` is not refined.
 pub const TIGHT_ENOUGH: f32 = 0.5;
+
+/// A ray in a volume's local index space, clipped to the volume's box, and
+/// the walk's position `t` along it: what every cell walk over a
+/// [`CellPartition`] shares (the segment walk here, the lattice march in
+/// `lattice.rs`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CellRay {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    /// `1 / dir`, with `+inf` where a component is zero (it never exits).
+    inv_dir: Vec3,
+    /// Where the walk is.
+    pub t: f32,
+    /// Where the ray leaves the volume (or ends).
+    pub t_end: f32,
+    /// Absolute part of the nudge: 1e-5 voxels along the ray's major axis.
+    nudge_abs: f32,
+    /// Per axis, whether the ray leaves a cell through its upper face.
+    upward: glam::BVec3,
+}
+
+impl CellRay {
+    /// The ray clipped to the volume's box and to `[t_min, t_max]`; a ray
+    /// with a non-finite or zero direction is empty.
+    pub fn new(volume: &BrickVolume, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
+        let inv_dir = dir.recip();
+        let (b0, b1) = Bounds3::new(Vec3::ZERO, volume.local_extent()).slab(origin, inv_dir);
+        // For exits: a zero component never exits (+inf, whatever the sign of zero).
+        let inv_dir = Vec3::select(dir.cmpeq(Vec3::ZERO), Vec3::INFINITY, inv_dir);
+        let valid = origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO;
+        let (t, t_end) = if valid {
+            (t_min.max(b0), t_max.min(b1))
+        } else {
+            (0.0, 0.0)
+        };
+        CellRay {
+            origin,
+            dir,
+            inv_dir,
+            t,
+            t_end,
+            nudge_abs: 1e-5 / dir.abs().max_element(),
+            upward: dir.cmpge(Vec3::ZERO),
+        }
+    }
+
+    /// How far past `t` the walk looks up the cell it is in (see the
+    /// module doc's robustness note).
+    #[inline]
+    pub fn nudge(&self) -> f32 {
+        self.t.abs() * 1e-6 + self.nudge_abs
+    }
+
+    /// Moves `t` to where the ray leaves the box `[lo, hi]` through its far
+    /// faces (the near ones are behind it), by at least `nudge` and at most
+    /// to the end of the ray; returns the `t` it left from. Every step ends
+    /// here, so every step makes progress (the module doc's guarantee).
+    #[inline]
+    pub fn leave(&mut self, lo: Vec3, hi: Vec3, nudge: f32) -> f32 {
+        let far = Vec3::select(self.upward, hi, lo);
+        let exit = ((far - self.origin) * self.inv_dir).min_element();
+        let t0 = self.t;
+        self.t = exit.max(t0 + nudge).min(self.t_end);
+        t0
+    }
+
+    /// Moves `t` past the empty cube of level-1 cells within
+    /// `distance - 1` of level-1 cell `c1` (a [`Cell::Empty`]).
+    #[inline]
+    pub fn leave_empty(&mut self, c1: IVec3, distance: u32, nudge: f32) {
+        let r = distance as i32 - 1;
+        let side = (1 << (CELL_LOG2 + 1)) as f32;
+        let lo = (c1 - r).as_vec3() * side;
+        let hi = (c1 + (r + 1)).as_vec3() * side;
+        self.leave(lo, hi, nudge);
+    }
+}
 
 /// Iterator of [`MajorantSegment`]s; see the module doc.
 pub struct SegmentIter<'a> {
     volume: &'a BrickVolume,
     partition: &'a CellPartition,
-    origin: Vec3,
-    dir: Vec3,
-    inv_dir: Vec3,
-    t: f32,
-    t_end: f32,
+    ray: CellRay,
     pending: Option<MajorantSegment>,
     /// Pyramid steps taken (cells visited), for statistics.
     pub steps: u32,
-    /// Absolute part of the nudge: 1e-5 voxels along the ray's major axis.
-    nudge_abs: f32,
-    /// Per axis, whether the ray leaves a cell through its upper face.
-    upward: glam::BVec3,
 }
 
 impl<'a> SegmentIter<'a> {
@@ -76,38 +145,23 @@ impl<'a> SegmentIter<'a> {
         t_min: f32,
         t_max: f32,
     ) -> Self {
-        let inv_dir = dir.recip();
-        let (b0, b1) = Bounds3::new(Vec3::ZERO, volume.local_extent()).slab(origin, inv_dir);
-        // For exits: a zero component never exits (+inf, whatever the sign of zero).
-        let inv_dir = Vec3::select(dir.cmpeq(Vec3::ZERO), Vec3::INFINITY, inv_dir);
-        let valid = origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO;
-        let (t, t_end) = if valid {
-            (t_min.max(b0), t_max.min(b1))
-        } else {
-            (0.0, 0.0)
-        };
         SegmentIter {
             volume,
             partition,
-            origin,
-            dir,
-            inv_dir,
-            t,
-            t_end,
+            ray: CellRay::new(volume, origin, dir, t_min, t_max),
             pending: None,
             steps: 0,
-            nudge_abs: 1e-5 / dir.abs().max_element(),
-            upward: dir.cmpge(Vec3::ZERO),
         }
     }
 
     /// The next raw (unmerged) segment, or `None` at the end of the ray.
     fn step(&mut self) -> Option<MajorantSegment> {
         let levels = &self.volume.levels;
-        while self.t < self.t_end {
+        let ray = &mut self.ray;
+        while ray.t < ray.t_end {
             self.steps += 1;
-            let nudge = self.t.abs() * 1e-6 + self.nudge_abs;
-            let p = self.origin + self.dir * (self.t + nudge);
+            let nudge = ray.nudge();
+            let p = ray.origin + ray.dir * (ray.t + nudge);
             let voxel = p.floor().as_ivec3();
             // The kept cell or empty cube holding `p` (`partition.rs`): one
             // table read. A point outside the volume (only ever by a nudge
@@ -125,13 +179,7 @@ impl<'a> SegmentIter<'a> {
                     ),
                 ),
                 Some(Cell::Empty { distance }) => {
-                    // Jump to the exit of the empty cube of level-1 cells
-                    // within `distance - 1` of this one.
-                    let r = distance as i32 - 1;
-                    let side = (1 << (CELL_LOG2 + 1)) as f32;
-                    let lo = (c1 - r).as_vec3() * side;
-                    let hi = (c1 + (r + 1)).as_vec3() * side;
-                    self.leave(lo, hi, nudge);
+                    ray.leave_empty(c1, distance, nudge);
                     continue;
                 }
                 None => (0, (0.0, 0.0)),
@@ -147,8 +195,8 @@ impl<'a> SegmentIter<'a> {
                 size = 1.0;
                 cell_lo = voxel.as_vec3();
             }
-            let t0 = self.leave(cell_lo, cell_lo + Vec3::splat(size), nudge);
-            let t1 = self.t;
+            let t0 = ray.leave(cell_lo, cell_lo + Vec3::splat(size), nudge);
+            let t1 = ray.t;
             if hi > 0.0 {
                 return Some(MajorantSegment {
                     t0,
@@ -159,19 +207,6 @@ impl<'a> SegmentIter<'a> {
             }
         }
         None
-    }
-
-    /// Moves `t` to where the ray leaves the box `[lo, hi]` through its far
-    /// faces (the near ones are behind it), by at least `nudge` and at most
-    /// to the end of the ray; returns the `t` it left from. Every step ends
-    /// here, so every step makes progress (the module doc's guarantee).
-    #[inline]
-    fn leave(&mut self, lo: Vec3, hi: Vec3, nudge: f32) -> f32 {
-        let far = Vec3::select(self.upward, hi, lo);
-        let exit = ((far - self.origin) * self.inv_dir).min_element();
-        let t0 = self.t;
-        self.t = exit.max(t0 + nudge).min(self.t_end);
-        t0
     }
 }
 

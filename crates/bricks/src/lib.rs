@@ -11,7 +11,10 @@
 //! ray through the pyramid front to back, skipping empty space at the
 //! coarsest level and yielding [`MajorantSegment`]s with tight bounds, over the
 //! cells of a [`CellPartition`] (`partition.rs`) fixed once per refinement rule;
-//! [`BrickVolume::trilinear`] is the density lookup. `format.rs` writes and
+//! [`BrickVolume::trilinear`] is the density lookup. A ray march needs
+//! no bounds, only where density is: [`BrickVolume::march_occupied`]
+//! (`lattice.rs`) visits the points of a jittered [`Lattice`] cell by cell
+//! over a partition's occupied cells. `format.rs` writes and
 //! memory-maps the `.cbrk` file of a converted volume. For motion blur,
 //! [`VelocityGrid`] (`velocity.rs`) stores a vec3 velocity grid and
 //! [`BrickVolume::motion_shell`] (`dilate.rs`) dilates the bounds pyramid
@@ -26,6 +29,7 @@ mod dda;
 mod dilate;
 mod f16;
 mod format;
+mod lattice;
 mod layout;
 mod partition;
 mod section;
@@ -39,6 +43,7 @@ pub use bounds::{BoundsLevel, CELL_LOG2, MAX_LEVELS};
 pub use convert::{convert, convert_tree, MAX_MAP_BRICKS};
 pub use dda::{SegmentIter, TIGHT_ENOUGH};
 pub use format::{read_cbrk, write_cbrk};
+pub use lattice::Lattice;
 pub use layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS};
 pub use partition::{Cell, CellPartition};
 pub use section::Section;

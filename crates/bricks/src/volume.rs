@@ -3,6 +3,8 @@
 
 use crate::bounds::BoundsLevel;
 use crate::f16::f16_bits_to_f32;
+#[cfg(target_arch = "x86_64")]
+use crate::f16::{f16x8_to_f32_f16c, has_f16c};
 use crate::layout::{voxel_offset, BrickRef, Precision, BRICK_LOG2};
 use crate::partition::CellPartition;
 use crate::section::Section;
@@ -315,6 +317,85 @@ impl BrickVolume {
     /// eight corners share it (7/8 of positions per axis), else each corner.
     #[inline]
     pub fn trilinear(&self, p: Vec3) -> f32 {
+        #[cfg(target_arch = "x86_64")]
+        if let Atlas::F16(a) = &self.atlas {
+            if has_f16c() {
+                // SAFETY: the CPU has F16C, checked just above.
+                return unsafe { self.trilinear_f16c(a, p) };
+            }
+        }
+        self.trilinear_with(p, |b, n| self.stored_corners(b, n))
+    }
+
+    /// [`trilinear`](Self::trilinear) over an f16 atlas, each stencil
+    /// inside a brick decoded by F16C at once: the same value, bit for
+    /// bit. Measured on the corpus cloud's ray march (f16 atlas): the
+    /// portable decode of the eight corners made a lookup about 10%
+    /// slower than one over an f32 atlas.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "f16c")]
+    fn trilinear_f16c(&self, atlas: &[u16], p: Vec3) -> f32 {
+        if !p.is_finite() {
+            return 0.0;
+        }
+        let f0 = p.floor();
+        let c = f0.as_ivec3();
+        let raw = if (c & 7).cmplt(IVec3::splat(7)).all() {
+            match self.brick_ref(c >> BRICK_LOG2 as i32) {
+                BrickRef::Empty => return 0.0,
+                BrickRef::Constant(k) => return self.constants[k as usize],
+                BrickRef::Stored(b) => {
+                    let base = b as usize * 512 + voxel_offset(c.x, c.y, c.z);
+                    let s = &atlas[base..base + 74];
+                    [s[0], s[1], s[8], s[9], s[64], s[65], s[72], s[73]]
+                }
+            }
+        } else {
+            match self.straddling_f16_bits(atlas, c) {
+                Some(raw) => raw,
+                None => return self.trilinear_with(p, |b, n| self.stored_corners(b, n)),
+            }
+        };
+        lerp_corners(f16x8_to_f32_f16c(raw), p - f0)
+    }
+
+    /// The raw f16 corners of a stencil across brick faces (0 for empty
+    /// bricks, as f16 0 is 0.0), each brick looked up once; `None` when a
+    /// constant brick is among them (its value is an f32).
+    #[inline(always)]
+    fn straddling_f16_bits(&self, atlas: &[u16], c: IVec3) -> Option<[u16; 8]> {
+        const EMPTY: usize = usize::MAX;
+        let b0 = c >> BRICK_LOG2 as i32;
+        let b1 = (c + 1) >> BRICK_LOG2 as i32;
+        let cross = (usize::from(b1.x != b0.x) << 2)
+            | (usize::from(b1.y != b0.y) << 1)
+            | usize::from(b1.z != b0.z);
+        let offset = |k: usize| IVec3::new((k >> 2) as i32, ((k >> 1) & 1) as i32, (k & 1) as i32);
+        let mut base = [EMPTY; 8];
+        for (k, b) in base.iter_mut().enumerate() {
+            if k & !cross == 0 {
+                match self.brick_ref(b0 + offset(k)) {
+                    BrickRef::Empty => {}
+                    BrickRef::Constant(_) => return None,
+                    BrickRef::Stored(i) => *b = i as usize * 512,
+                }
+            }
+        }
+        let mut raw = [0u16; 8];
+        for (k, r) in raw.iter_mut().enumerate() {
+            let b = base[k & cross];
+            if b != EMPTY {
+                let q = c + offset(k);
+                *r = atlas[b + voxel_offset(q.x, q.y, q.z)];
+            }
+        }
+        Some(raw)
+    }
+
+    /// The trilinear lookup, with `stored(b, n)` the eight corners of a
+    /// stencil at voxel `n` inside stored brick `b`.
+    #[inline(always)]
+    fn trilinear_with(&self, p: Vec3, stored: impl Fn(u32, usize) -> [f32; 8]) -> f32 {
         if !p.is_finite() {
             return 0.0;
         }
@@ -325,16 +406,12 @@ impl BrickVolume {
             match self.brick_ref(c >> BRICK_LOG2 as i32) {
                 BrickRef::Empty => return 0.0,
                 BrickRef::Constant(k) => return self.constants[k as usize],
-                BrickRef::Stored(b) => self.stored_corners(b, voxel_offset(c.x, c.y, c.z)),
+                BrickRef::Stored(b) => stored(b, voxel_offset(c.x, c.y, c.z)),
             }
         } else {
             self.straddling_corners(c)
         };
-        // Corners ordered x-major: v[4x + 2y + z].
-        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-        let x0 = lerp(lerp(v[0], v[1], f.z), lerp(v[2], v[3], f.z), f.y);
-        let x1 = lerp(lerp(v[4], v[5], f.z), lerp(v[6], v[7], f.z), f.y);
-        lerp(x0, x1, f.x)
+        lerp_corners(v, f)
     }
 
     /// Largest value of the volume (the global majorant).
@@ -342,5 +419,64 @@ impl BrickVolume {
         self.levels.last().map_or(0.0, |l| {
             l.cells.chunks_exact(2).fold(0.0, |m, c| m.max(c[1]))
         })
+    }
+}
+
+/// Trilinear interpolation of a stencil's corners, ordered x-major
+/// (`v[4x + 2y + z]`), at fractional position `f`.
+#[inline(always)]
+fn lerp_corners(v: [f32; 8], f: Vec3) -> f32 {
+    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+    let x0 = lerp(lerp(v[0], v[1], f.z), lerp(v[2], v[3], f.z), f.y);
+    let x1 = lerp(lerp(v[4], v[5], f.z), lerp(v[6], v[7], f.z), f.y);
+    lerp(x0, x1, f.x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::convert::convert_tree;
+    use cirrus_testkit::SplitMix64;
+    use cirrus_vdb::{Coord, Tree};
+
+    /// Over an f16 atlas the lookup (through F16C where the CPU has it)
+    /// gives exactly the portable lookup's value, inside bricks and across
+    /// their faces, next to empty and constant bricks: 200,000 points over
+    /// a volume of random voxels, a hole and a constant 8^3 block.
+    #[test]
+    fn f16_lookups_equal_the_portable_decode_bit_for_bit() {
+        let mut rng = SplitMix64(7);
+        let mut tree = Tree::new(0.0f32);
+        for x in 0..24 {
+            for y in 0..24 {
+                for z in 0..24 {
+                    let hole = (8..16).contains(&x) && (8..16).contains(&y) && z < 8;
+                    let block = x >= 16 && y >= 16 && z >= 16;
+                    let value = if block { 0.75 } else { 3.0 * rng.unit() };
+                    if !hole && (block || rng.below(3) > 0) {
+                        tree.set_value_on(Coord::new(x, y, z), value);
+                    }
+                }
+            }
+        }
+        let volume = convert_tree(&tree, Precision::F16).unwrap();
+        assert_eq!(volume.precision(), Precision::F16);
+        assert!(!volume.constants.is_empty(), "the block is a constant brick");
+        let (mut positive, mut straddling) = (0, 0);
+        for _ in 0..200_000 {
+            // Index space [-1, 25)^3, in the volume's local coordinates.
+            let p = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 26.0
+                - 1.0
+                - volume.origin.as_vec3();
+            let fast = volume.trilinear(p);
+            let portable = volume.trilinear_with(p, |b, n| volume.stored_corners(b, n));
+            assert_eq!(fast.to_bits(), portable.to_bits(), "at {p}");
+            positive += usize::from(fast > 0.0);
+            straddling += usize::from((p.floor().as_ivec3() & 7).cmpeq(IVec3::splat(7)).any());
+        }
+        assert!(
+            positive > 100_000 && straddling > 50_000,
+            "{positive} {straddling}"
+        );
     }
 }

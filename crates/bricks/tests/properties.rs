@@ -1,7 +1,9 @@
 //! Property tests of conversion, lookups and the majorant walk against the
 //! reader's own tree (the independent reference).
 
-use cirrus_bricks::{convert_tree, BrickVolume, Cell, MajorantSegment, Precision, TIGHT_ENOUGH};
+use cirrus_bricks::{
+    convert_tree, BrickVolume, Cell, Lattice, MajorantSegment, Precision, TIGHT_ENOUGH,
+};
 use cirrus_vdb::{Coord, Tree};
 use glam::{IVec3, Vec3};
 use proptest::prelude::*;
@@ -457,5 +459,72 @@ proptest! {
         }
         prop_assert_eq!(kept + empty, (dx * dy * dz) as usize);
         prop_assert!(kept > 0);
+    }
+}
+
+proptest! {
+    // About a third of these rays meet a blob.
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// The march over occupied cells finds every lattice point with
+    /// density: the same points, at the same `t` and with the same density,
+    /// as a march over the occupancy segments, and as a brute-force march
+    /// of every lattice point inside the volume's box from the same origin
+    /// (the first positive segment's start).
+    #[test]
+    fn the_occupied_march_finds_every_lattice_point_with_density(
+        seed in 0u64..1000,
+        o in prop::array::uniform3(-20f32..80.0),
+        target in prop::array::uniform3(4f32..40.0),
+        h in 0.2f32..4.0,
+        u in 0f32..1.0,
+    ) {
+        let tree = random_tree(seed, IVec3::new(-7, 2, 30));
+        let vol = convert_tree(&tree, Precision::F32).unwrap();
+        // Rays through the blobs' region, from anywhere around it.
+        let d = (Vec3::from(target) - Vec3::from(o)) / 64.0;
+        prop_assume!(d.length() > 1e-3);
+        let lo = local(&vol, Vec3::from(o) + IVec3::new(-7, 2, 30).as_vec3());
+        let cells = vol.occupancy_partition(1);
+        let lattice = Lattice::new(h, u);
+        let t_max = 300.0;
+        let with_density = |t: f32| (t, vol.trilinear(lo + d * t));
+        let mut by_segments = Vec::new();
+        lattice.visit_segments(vol.segments_in(&cells, lo, d, 0.0, t_max), |t| {
+            by_segments.push(with_density(t));
+            true
+        });
+        let mut by_cells = Vec::new();
+        vol.march_occupied(&cells, lo, d, t_max, lattice, |t, v| {
+            by_cells.push((t, v));
+            true
+        });
+        for &(t, v) in &by_cells {
+            prop_assert_eq!(v, with_density(t).1);
+        }
+        let positive = |v: &Vec<(f32, f32)>| v.iter().copied().filter(|p| p.1 > 0.0).collect::<Vec<_>>();
+        prop_assert_eq!(positive(&by_cells), positive(&by_segments));
+        let org = vol
+            .segments_in(&cells, lo, d, 0.0, t_max)
+            .find(|s| s.majorant > 0.0)
+            .map(|s| s.t0);
+        let extent = vol.local_extent();
+        let mut brute = Vec::new();
+        if let Some(org) = org {
+            let mut k = 0;
+            loop {
+                let t = lattice.at(org, k);
+                let p = lo + d * t;
+                if t >= t_max || (k > 0 && !(p.cmpge(Vec3::ZERO).all() && p.cmplt(extent).all()) && t > org + 2.0 * h) {
+                    break;
+                }
+                if p.cmpge(Vec3::ZERO).all() && p.cmplt(extent).all() {
+                    brute.push(with_density(t));
+                }
+                k += 1;
+            }
+        }
+        prop_assert_eq!(positive(&by_cells), positive(&brute));
+        prop_assert!(by_cells.len() <= brute.len());
     }
 }

@@ -20,7 +20,9 @@ pub struct Counters {
     /// Tentative collisions of ratio and residual tracking (shadow rays),
     /// each a density lookup and a weight.
     pub shadow_collisions: u64,
-    /// Majorant segments visited by the trackers and ray marchers.
+    /// Majorant segments visited by the trackers; for the ray marchers,
+    /// the walk's steps (segments, or over occupied cells: one to enter
+    /// the first, one per empty cube skipped).
     pub dda_segments: u64,
     pub shadow_rays: u64,
     /// Tracker calls stopped by the per-call collision cap.

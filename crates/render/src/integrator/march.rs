@@ -18,13 +18,13 @@ use glam::Vec3;
 
 use super::{escaped_radiance, Sample};
 use crate::light::Lights;
-use crate::medium::Media;
+use crate::medium::{Lattice, Media};
 use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
-use crate::tracking::roulette;
 use crate::tracking::spectral::roulette_rgb;
+use crate::tracking::{roulette, ROULETTE_Q, ROULETTE_THRESHOLD};
 
 /// Extinction and transmittance of one channel (`f32`) or three (`Vec3`).
 pub(crate) trait Channels: Copy {
@@ -32,6 +32,9 @@ pub(crate) trait Channels: Copy {
     const ONE: Self;
     /// Extinction at `p`.
     fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self;
+    /// The channels of a medium whose extinction is `tint` times `sigma`
+    /// ([`Media::uniform_tint`]).
+    fn tinted(sigma: f32, tint: Vec3) -> Self;
     /// Whether any channel has positive extinction (false for NaN).
     fn any_positive(self) -> bool;
     fn scale(self, h: f32) -> Self;
@@ -55,6 +58,10 @@ impl Channels for f32 {
     #[inline]
     fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self {
         medium.sigma_t(p)
+    }
+    #[inline]
+    fn tinted(sigma: f32, _tint: Vec3) -> Self {
+        sigma
     }
     #[inline]
     fn any_positive(self) -> bool {
@@ -106,6 +113,10 @@ impl Channels for Vec3 {
         medium.sigma_t_rgb_at(p, 0.0)
     }
     #[inline]
+    fn tinted(sigma: f32, tint: Vec3) -> Self {
+        tint * sigma
+    }
+    #[inline]
     fn any_positive(self) -> bool {
         self.max_element() > 0.0
     }
@@ -155,7 +166,10 @@ const TAU_CUTOFF: f32 = 30.0;
 pub const MIN_STEP_VOXELS: f32 = 1e-3;
 
 /// Calls `visit(t, sigma_t, counters)` at each jittered lattice point along
-/// `ray` within `[0, t_max]`; `visit` returns false to stop.
+/// `ray` within `[0, t_max]` where the extinction may be non-zero
+/// ([`Media::march_lattice`]); `visit` returns false to stop. Media whose
+/// channels share one tint look one scalar up per point; others look each
+/// channel up.
 pub(crate) fn march<M: Media, E: Channels>(
     medium: &M,
     ray: &Ray,
@@ -165,31 +179,18 @@ pub(crate) fn march<M: Media, E: Channels>(
     c: &mut Counters,
     mut visit: impl FnMut(f32, E, &mut Counters) -> bool,
 ) {
-    let mut origin = None;
-    let mut next_k = 0i64;
-    for s in medium.majorants(ray.origin, ray.dir, 0.0, t_max) {
-        c.dda_segments += 1;
-        if s.majorant.is_nan() || s.majorant <= 0.0 {
-            continue;
-        }
-        let org = *origin.get_or_insert(s.t0);
-        // First lattice point at or after the segment's start; never revisit
-        // one that rounding placed in the previous segment too.
-        let mut k = next_k.max(((s.t0 - org) / h - u).ceil() as i64);
-        loop {
-            let t = org + (k as f32 + u) * h;
-            if t >= s.t1 {
-                break;
-            }
-            k += 1;
+    let lattice = Lattice::new(h, u);
+    let steps = match medium.uniform_tint() {
+        Some(tint) => medium.march_lattice(ray.origin, ray.dir, t_max, lattice, |t, sigma| {
             c.density_lookups += 1;
-            let sigma = E::sigma_t(medium, ray.at(t));
-            if !visit(t, sigma, c) {
-                return;
-            }
-        }
-        next_k = k;
-    }
+            visit(t, E::tinted(sigma, tint), c)
+        }),
+        None => lattice.visit_segments(medium.majorants(ray.origin, ray.dir, 0.0, t_max), |t| {
+            c.density_lookups += 1;
+            visit(t, E::sigma_t(medium, ray.at(t)), c)
+        }),
+    };
+    c.dda_segments += steps;
 }
 
 /// How a marched shadow ray ends inside a dense medium.
@@ -231,15 +232,36 @@ pub(crate) fn marched_transmittance<M: Media, E: Channels>(
             tau.exp_neg()
         }
         ShadowEnd::Roulette => {
-            let mut tr = E::ONE;
+            // The estimate is `w exp(-tau)`. It is rouletted as the
+            // trackers' estimates are ([`roulette`]) once its largest
+            // channel falls below the threshold, that is once every
+            // channel's optical depth passes `ln(w / threshold)`: so the
+            // march sums optical depth and takes no `exp` per step.
+            let mut tau = E::ZERO;
+            let mut w = 1.0f32;
+            let mut tau_roulette = ROULETTE_THRESHOLD.recip().ln();
+            let mut survived = true;
             march(medium, &ray, f32::INFINITY, h, u, c, |_, sigma: E, _| {
                 if !sigma.any_positive() {
                     return true;
                 }
-                tr = tr.mul(sigma.scale(h).exp_neg());
-                tr.roulette(rng)
+                tau = tau.add(sigma.scale(h));
+                if tau.min_channel() <= tau_roulette {
+                    return true;
+                }
+                if rng.uniform() < ROULETTE_Q {
+                    survived = false;
+                    return false;
+                }
+                w /= 1.0 - ROULETTE_Q;
+                tau_roulette = (w / ROULETTE_THRESHOLD).ln();
+                true
             });
-            tr
+            if survived {
+                tau.exp_neg().scale(w)
+            } else {
+                E::ZERO
+            }
         }
     }
 }

@@ -12,7 +12,7 @@
 //! volume's dilated motion shell; at time 0, and without motion, nothing
 //! changes.
 
-use super::field::{Bounds3, DensityField};
+use super::field::{Bounds3, DensityField, Lattice};
 use super::motion::{Motion, Velocity};
 use crate::shutter::Shutter;
 use cirrus_bricks::{BrickError, BrickVolume, CellPartition, DBounds3, SegmentIter};
@@ -217,6 +217,29 @@ impl DensityField for BrickField<'_> {
         match &self.partition {
             Some(cells) => walked.segments_in(cells, o, d, t_min, t_max),
             None => walked.segments(o, d, t_min, t_max),
+        }
+    }
+
+    /// A still field walked by occupancy looks its lattice points up cell
+    /// by cell ([`BrickVolume::march_occupied`]); any other walks its
+    /// segments.
+    fn march_lattice(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        mut visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        match (&self.partition, self.cells, &self.motion) {
+            (Some(cells), Some(CellRule::Occupancy), None) => {
+                let (o, d) = self.local_ray(origin, dir);
+                self.volume
+                    .march_occupied(cells, o, d, t_max, lattice, visit)
+            }
+            _ => lattice.visit_segments(self.segments(origin, dir, 0.0, t_max), |t| {
+                visit(t, self.density(origin + dir * t))
+            }),
         }
     }
 

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-pub use cirrus_bricks::{Bounds3, MajorantSegment};
+pub use cirrus_bricks::{Bounds3, Lattice, MajorantSegment};
 
 /// A density field in render space (world space minus an offset chosen by the
 /// caller so coordinates stay small in `f32`).
@@ -36,6 +36,25 @@ pub trait DensityField: Send + Sync {
     /// `dir` need not be normalised; t is in units of `dir`.
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_>;
 
+    /// Calls `visit(t, density)` at the points of `lattice` along the ray
+    /// within `[0, t_max]` where the density may be non-zero (its origin:
+    /// where the ray enters the first segment with a positive majorant),
+    /// until `visit` returns false; returns the walk's steps. What a ray
+    /// march needs: a field may find those points faster than by walking
+    /// its segments, which is the default.
+    fn march_lattice(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        mut visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        lattice.visit_segments(self.segments(origin, dir, 0.0, t_max), |t| {
+            visit(t, self.density(origin + dir * t))
+        })
+    }
+
     /// One majorant for the whole field (for the global-majorant mode).
     fn global_majorant(&self) -> f32;
 
@@ -61,6 +80,16 @@ impl<T: DensityField + ?Sized> DensityField for &T {
     }
     fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Segments<'_> {
         (**self).segments(origin, dir, t_min, t_max)
+    }
+    fn march_lattice(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        (**self).march_lattice(origin, dir, t_max, lattice, visit)
     }
     fn global_majorant(&self) -> f32 {
         (**self).global_majorant()

@@ -17,7 +17,7 @@
 
 use glam::Vec3;
 
-use super::field::{Bounds3, DensityField, MajorantSegment};
+use super::field::{Bounds3, DensityField, Lattice, MajorantSegment};
 use super::Medium;
 use crate::phase::Phase;
 use crate::sampling::Rng;
@@ -56,6 +56,31 @@ pub trait Media: Send + Sync {
     /// Total extinction coefficient at `p` (of chromatic media: the sum of
     /// each instance's largest channel, a bound of every channel).
     fn sigma_t(&self, p: Vec3) -> f32;
+
+    /// Calls `visit(t, sigma_t)` at the points of `lattice` along the ray
+    /// within `[0, t_max]` where the extinction may be non-zero (see
+    /// [`DensityField::march_lattice`]), until `visit` returns false;
+    /// returns the walk's steps. The default walks the majorant segments.
+    fn march_lattice(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        mut visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        lattice.visit_segments(self.majorants(origin, dir, 0.0, t_max), |t| {
+            visit(t, self.sigma_t(origin + dir * t))
+        })
+    }
+
+    /// `Some(tint)` when every channel's extinction is `tint` times
+    /// [`sigma_t`](Self::sigma_t) everywhere (grey media: 1), so a march
+    /// can look up one scalar; `None` for mixtures of differently tinted
+    /// media.
+    fn uniform_tint(&self) -> Option<Vec3> {
+        (!self.chromatic()).then_some(Vec3::ONE)
+    }
 
     /// Total extinction at `p` at shutter time `time` (what the trackers
     /// look up: a ray's time). Media without motion are the same at every
@@ -170,6 +195,23 @@ impl<F: DensityField> Media for Medium<F> {
     #[inline]
     fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
         self.density_scale * self.field.density_at(p, time)
+    }
+
+    fn march_lattice(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        mut visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        let scale = self.density_scale;
+        self.field
+            .march_lattice(origin, dir, t_max, lattice, |t, d| visit(t, scale * d))
+    }
+
+    fn uniform_tint(&self) -> Option<Vec3> {
+        Some(self.extinction_tint)
     }
 
     fn chromatic(&self) -> bool {

@@ -26,7 +26,7 @@ mod motion;
 pub use brick_field::BrickField;
 #[cfg(feature = "testing")]
 pub use constant_box::ConstantBox;
-pub use field::{Bounds3, DensityField, MajorantSegment};
+pub use field::{Bounds3, DensityField, Lattice, MajorantSegment};
 #[cfg(feature = "testing")]
 pub use grid_field::GridField;
 #[cfg(feature = "testing")]
