@@ -274,6 +274,25 @@ impl BrickVolume {
             })
     }
 
+    /// The bricks a stencil at voxel `c` touches: `cross`, the corner index
+    /// bits (x 4, y 2, z 1) along which it crosses a brick face, and the
+    /// brick of each corner `k` at slot `k & cross` (the other slots empty).
+    #[inline(always)]
+    fn straddled_bricks(&self, c: IVec3) -> (usize, [BrickRef; 8]) {
+        let b0 = c >> BRICK_LOG2 as i32;
+        let b1 = (c + 1) >> BRICK_LOG2 as i32;
+        let cross = (usize::from(b1.x != b0.x) << 2)
+            | (usize::from(b1.y != b0.y) << 1)
+            | usize::from(b1.z != b0.z);
+        let mut bricks = [BrickRef::Empty; 8];
+        for (k, b) in bricks.iter_mut().enumerate() {
+            if k & !cross == 0 {
+                *b = self.brick_ref(b0 + corner_offset(k));
+            }
+        }
+        (cross, bricks)
+    }
+
     /// The eight voxels `c + {0, 1}^3` (ordered `v[4x + 2y + z]`) of a
     /// stencil that crosses a brick face: each distinct brick it touches is
     /// looked up once, two across a face, four at an edge, eight only at a
@@ -281,22 +300,10 @@ impl BrickVolume {
     /// brick up eight times.
     #[inline]
     fn straddling_corners(&self, c: IVec3) -> [f32; 8] {
-        let b0 = c >> BRICK_LOG2 as i32;
-        let b1 = (c + 1) >> BRICK_LOG2 as i32;
-        // Corner index bits (x 4, y 2, z 1) along which the stencil crosses.
-        let cross = (usize::from(b1.x != b0.x) << 2)
-            | (usize::from(b1.y != b0.y) << 1)
-            | usize::from(b1.z != b0.z);
-        let offset = |k: usize| IVec3::new((k >> 2) as i32, ((k >> 1) & 1) as i32, (k & 1) as i32);
-        let mut bricks = [BrickRef::Empty; 8];
-        for (k, b) in bricks.iter_mut().enumerate() {
-            if k & !cross == 0 {
-                *b = self.brick_ref(b0 + offset(k));
-            }
-        }
+        let (cross, bricks) = self.straddled_bricks(c);
         let mut v = [0.0; 8];
         for (k, out) in v.iter_mut().enumerate() {
-            let q = c + offset(k);
+            let q = c + corner_offset(k);
             *out = match bricks[k & cross] {
                 BrickRef::Empty => 0.0,
                 BrickRef::Constant(i) => self.constants[i as usize],
@@ -365,27 +372,20 @@ impl BrickVolume {
     #[inline(always)]
     fn straddling_f16_bits(&self, atlas: &[u16], c: IVec3) -> Option<[u16; 8]> {
         const EMPTY: usize = usize::MAX;
-        let b0 = c >> BRICK_LOG2 as i32;
-        let b1 = (c + 1) >> BRICK_LOG2 as i32;
-        let cross = (usize::from(b1.x != b0.x) << 2)
-            | (usize::from(b1.y != b0.y) << 1)
-            | usize::from(b1.z != b0.z);
-        let offset = |k: usize| IVec3::new((k >> 2) as i32, ((k >> 1) & 1) as i32, (k & 1) as i32);
+        let (cross, bricks) = self.straddled_bricks(c);
         let mut base = [EMPTY; 8];
-        for (k, b) in base.iter_mut().enumerate() {
-            if k & !cross == 0 {
-                match self.brick_ref(b0 + offset(k)) {
-                    BrickRef::Empty => {}
-                    BrickRef::Constant(_) => return None,
-                    BrickRef::Stored(i) => *b = i as usize * 512,
-                }
+        for (b, r) in base.iter_mut().zip(bricks) {
+            match r {
+                BrickRef::Empty => {}
+                BrickRef::Constant(_) => return None,
+                BrickRef::Stored(i) => *b = i as usize * 512,
             }
         }
         let mut raw = [0u16; 8];
         for (k, r) in raw.iter_mut().enumerate() {
             let b = base[k & cross];
             if b != EMPTY {
-                let q = c + offset(k);
+                let q = c + corner_offset(k);
                 *r = atlas[b + voxel_offset(q.x, q.y, q.z)];
             }
         }
@@ -420,6 +420,12 @@ impl BrickVolume {
             l.cells.chunks_exact(2).fold(0.0, |m, c| m.max(c[1]))
         })
     }
+}
+
+/// The offset of a stencil's corner `k` (`k = 4x + 2y + z`).
+#[inline(always)]
+fn corner_offset(k: usize) -> IVec3 {
+    IVec3::new((k >> 2) as i32, ((k >> 1) & 1) as i32, (k & 1) as i32)
 }
 
 /// Trilinear interpolation of a stencil's corners, ordered x-major
@@ -461,7 +467,10 @@ mod tests {
         }
         let volume = convert_tree(&tree, Precision::F16).unwrap();
         assert_eq!(volume.precision(), Precision::F16);
-        assert!(!volume.constants.is_empty(), "the block is a constant brick");
+        assert!(
+            !volume.constants.is_empty(),
+            "the block is a constant brick"
+        );
         let (mut positive, mut straddling) = (0, 0);
         for _ in 0..200_000 {
             // Index space [-1, 25)^3, in the volume's local coordinates.
