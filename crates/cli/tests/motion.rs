@@ -4,7 +4,7 @@
 mod common;
 
 use common::cirrus;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("cirrus-motion-{}-{name}", std::process::id()));
@@ -12,7 +12,7 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
-fn render(out: &PathBuf, extra: &[&str]) -> (bool, String) {
+fn render(out: &Path, extra: &[&str]) -> (bool, String) {
     let mut args = vec![
         "render",
         "data/multi_grid.vdb",

@@ -75,8 +75,8 @@ pub fn sample_free_flight_spectral<M: Media>(
                 let maj = segment.majorant;
                 let sigma = lookup_rgb(medium, ray, t, maj, c);
                 let mean_beta = beta.element_sum();
-                if !(mean_beta > 0.0) {
-                    // A dead path: nothing left to weight.
+                if mean_beta.is_nan() || mean_beta <= 0.0 {
+                    // A dead path (or a NaN one): nothing left to weight.
                     *beta = Vec3::ZERO;
                     return FreeFlight::Capped;
                 }
@@ -155,7 +155,7 @@ pub fn ratio_tracking_rgb<M: Media>(
 #[inline]
 pub(crate) fn roulette_rgb(tr: &mut Vec3, rng: &mut Rng) -> bool {
     let m = tr.max_element();
-    if !(m > 0.0) {
+    if m.is_nan() || m <= 0.0 {
         *tr = Vec3::ZERO;
         return false;
     }
