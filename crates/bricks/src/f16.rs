@@ -52,6 +52,7 @@ pub(crate) fn has_f16c() -> bool {
 /// for a lookup's eight corners at once.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "f16c")]
+#[inline]
 pub(crate) fn f16x8_to_f32_f16c(h: [u16; 8]) -> [f32; 8] {
     use std::arch::x86_64::{__m128, _mm_cvtph_ps, _mm_set_epi16, _mm_srli_si128};
     let v = _mm_set_epi16(
