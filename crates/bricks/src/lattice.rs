@@ -17,9 +17,10 @@
 //!   as a lookup per point on the corpus cloud; the table read costs a
 //!   fraction of that.
 //!
-//! Both give the same points: empty cells (bounds 0) hold no density, the
-//! trilinear stencil included (`bounds.rs`), so the points either way
-//! skips are points of density 0.
+//! Both find every point with density (the property tests compare them
+//! with a march of every point): empty cells (bounds 0) hold no density,
+//! the trilinear stencil included (`bounds.rs`), so whatever either skips
+//! has density 0.
 
 use crate::dda::CellRay;
 use crate::partition::{Cell, CellPartition};
