@@ -22,6 +22,7 @@ import json
 import os
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -92,6 +93,28 @@ def start_preview(preview_cmd, work, res, max_spp):
     return proc, line[line.index("http://"):].split()[0]
 
 
+def stop_chromium(proc):
+    """Ends chromium and every process it started (its own session): the
+    renderer and helper processes outlive the browser process by a moment
+    and write to the profile, which the temporary directory's clean-up
+    would otherwise race."""
+    for sig, grace in ((signal.SIGTERM, 10), (signal.SIGKILL, 5)):
+        try:
+            os.killpg(proc.pid, sig)
+        except ProcessLookupError:
+            return
+        deadline = time.time() + grace
+        while time.time() < deadline:
+            try:
+                os.killpg(proc.pid, 0)
+            except ProcessLookupError:
+                proc.wait()
+                return
+            proc.poll()
+            time.sleep(0.05)
+    proc.wait()
+
+
 def start_chromium(profile, width, height):
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     if not chromium:
@@ -101,14 +124,14 @@ def start_chromium(profile, width, height):
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
          f"--user-data-dir={profile}", "--remote-debugging-port=0", f"--window-size={width},{height}",
          "--force-color-profile=srgb", "about:blank"],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     port_file = Path(profile) / "DevToolsActivePort"
     for _ in range(300):
         if port_file.exists() and port_file.read_text().strip():
             break
         time.sleep(0.1)
     else:
-        proc.kill()
+        stop_chromium(proc)
         raise RuntimeError("chromium did not open its DevTools port")
     port = port_file.read_text().split()[0]
     targets = json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list"))
@@ -248,8 +271,7 @@ def test(args, work):
     finally:
         proc.terminate()
         if browser:
-            browser.terminate()
-            browser.wait()
+            stop_chromium(browser)
         proc.wait()
 
 
@@ -269,8 +291,7 @@ def docs(args, work):
     finally:
         proc.terminate()
         if browser:
-            browser.terminate()
-            browser.wait()
+            stop_chromium(browser)
         proc.wait()
 
 
