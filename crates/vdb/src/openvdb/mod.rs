@@ -19,6 +19,7 @@ pub(crate) mod blosc;
 mod compression;
 pub mod stream;
 mod tree_reader;
+mod window;
 
 use crate::bytes::ByteCursor;
 use crate::error::{corrupt, unsupported, ErrorKind, KindResult};
