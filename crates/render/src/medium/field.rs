@@ -10,7 +10,10 @@ pub use cirrus_bricks::{Bounds3, Lattice, MajorantSegment};
 ///
 /// The trackers only ever need two things from a field: point lookups and,
 /// along a ray, piecewise-constant bounds of the density. How tight those
-/// bounds are is what decides the cost of null-collision tracking.
+/// bounds are is what decides the cost of null-collision tracking. A ray
+/// march needs no bounds, only where the density may be non-zero:
+/// [`march_lattice`](Self::march_lattice) lets a field find its lattice
+/// points without walking its segments.
 pub trait DensityField: Send + Sync {
     type Segments<'a>: Iterator<Item = MajorantSegment>
     where
