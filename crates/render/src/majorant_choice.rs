@@ -29,8 +29,8 @@ use crate::stats::Counters;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Paths traced over each structure, in parallel chunks of
-/// [`PROBE_CHUNK`]. On the corpus cloud the probe takes about 20 ms
+/// Paths traced over each structure, in parallel chunks of 64
+/// (`PROBE_CHUNK`). On the corpus cloud the probe takes about 20 ms
 /// (128x128 at 1 spp renders in 60 ms), and its choices on the scenes of
 /// BENCHMARKS.md match 4,096 paths' wherever the two costs differ by more
 /// than a few percent.
