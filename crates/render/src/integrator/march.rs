@@ -59,6 +59,9 @@ impl Channels for f32 {
     fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self {
         medium.sigma_t(p)
     }
+    /// The scalar extinction itself, as [`Channels::sigma_t`] gives it
+    /// (of a chromatic medium, its largest channel: what the light grid
+    /// marches).
     #[inline]
     fn tinted(sigma: f32, _tint: Vec3) -> Self {
         sigma
