@@ -48,10 +48,6 @@ impl Lattice {
         }
     }
 
-    pub fn step(self) -> f32 {
-        self.h
-    }
-
     /// Point `k` of the lattice starting at `org`.
     #[inline]
     pub fn at(self, org: f32, k: i64) -> f32 {

@@ -12,7 +12,7 @@
 //! volume's dilated motion shell; at time 0, and without motion, nothing
 //! changes.
 
-use super::field::{Bounds3, DensityField, Lattice};
+use super::field::{march_segments, Bounds3, DensityField, Lattice};
 use super::motion::{Motion, Velocity};
 use crate::shutter::Shutter;
 use cirrus_bricks::{BrickError, BrickVolume, CellPartition, DBounds3, SegmentIter};
@@ -229,7 +229,7 @@ impl DensityField for BrickField<'_> {
         dir: Vec3,
         t_max: f32,
         lattice: Lattice,
-        mut visit: impl FnMut(f32, f32) -> bool,
+        visit: impl FnMut(f32, f32) -> bool,
     ) -> u64 {
         match (&self.partition, self.cells, &self.motion) {
             (Some(cells), Some(CellRule::Occupancy), None) => {
@@ -237,9 +237,7 @@ impl DensityField for BrickField<'_> {
                 self.volume
                     .march_occupied(cells, o, d, t_max, lattice, visit)
             }
-            _ => lattice.visit_segments(self.segments(origin, dir, 0.0, t_max), |t| {
-                visit(t, self.density(origin + dir * t))
-            }),
+            _ => march_segments(self, origin, dir, t_max, lattice, visit),
         }
     }
 

@@ -51,11 +51,9 @@ pub trait DensityField: Send + Sync {
         dir: Vec3,
         t_max: f32,
         lattice: Lattice,
-        mut visit: impl FnMut(f32, f32) -> bool,
+        visit: impl FnMut(f32, f32) -> bool,
     ) -> u64 {
-        lattice.visit_segments(self.segments(origin, dir, 0.0, t_max), |t| {
-            visit(t, self.density(origin + dir * t))
-        })
+        march_segments(self, origin, dir, t_max, lattice, visit)
     }
 
     /// One majorant for the whole field (for the global-majorant mode).
@@ -100,4 +98,19 @@ impl<T: DensityField + ?Sized> DensityField for &T {
     fn voxel_size(&self) -> f32 {
         (**self).voxel_size()
     }
+}
+
+/// The march of [`DensityField::march_lattice`] over `field`'s segments:
+/// the default, and what a field that can do better falls back to.
+pub fn march_segments<F: DensityField + ?Sized>(
+    field: &F,
+    origin: Vec3,
+    dir: Vec3,
+    t_max: f32,
+    lattice: Lattice,
+    mut visit: impl FnMut(f32, f32) -> bool,
+) -> u64 {
+    lattice.visit_segments(field.segments(origin, dir, 0.0, t_max), |t| {
+        visit(t, field.density(origin + dir * t))
+    })
 }
