@@ -331,7 +331,11 @@ impl BrickVolume {
                 return unsafe { self.trilinear_f16c(a, p) };
             }
         }
-        self.trilinear_with(p, |b, n| self.stored_corners(b, n))
+        self.trilinear_with(
+            p,
+            |b, n| self.stored_corners(b, n),
+            |c| self.straddling_corners(c),
+        )
     }
 
     /// [`trilinear`](Self::trilinear) over an f16 atlas, each stencil
@@ -342,28 +346,18 @@ impl BrickVolume {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "f16c")]
     fn trilinear_f16c(&self, atlas: &[u16], p: Vec3) -> f32 {
-        if !p.is_finite() {
-            return 0.0;
-        }
-        let f0 = p.floor();
-        let c = f0.as_ivec3();
-        let raw = if (c & 7).cmplt(IVec3::splat(7)).all() {
-            match self.brick_ref(c >> BRICK_LOG2 as i32) {
-                BrickRef::Empty => return 0.0,
-                BrickRef::Constant(k) => return self.constants[k as usize],
-                BrickRef::Stored(b) => {
-                    let base = b as usize * 512 + voxel_offset(c.x, c.y, c.z);
-                    let s = &atlas[base..base + 74];
-                    [s[0], s[1], s[8], s[9], s[64], s[65], s[72], s[73]]
-                }
-            }
-        } else {
-            match self.straddling_f16_bits(atlas, c) {
-                Some(raw) => raw,
-                None => return self.trilinear_with(p, |b, n| self.stored_corners(b, n)),
-            }
-        };
-        lerp_corners(f16x8_to_f32_f16c(raw), p - f0)
+        self.trilinear_with(
+            p,
+            |b, n| {
+                let base = b as usize * 512 + n;
+                let s = &atlas[base..base + 74];
+                f16x8_to_f32_f16c([s[0], s[1], s[8], s[9], s[64], s[65], s[72], s[73]])
+            },
+            |c| match self.straddling_f16_bits(atlas, c) {
+                Some(raw) => f16x8_to_f32_f16c(raw),
+                None => self.straddling_corners(c),
+            },
+        )
     }
 
     /// The raw f16 corners of a stencil across brick faces (0 for empty
@@ -393,9 +387,15 @@ impl BrickVolume {
     }
 
     /// The trilinear lookup, with `stored(b, n)` the eight corners of a
-    /// stencil at voxel `n` inside stored brick `b`.
+    /// stencil at voxel `n` inside stored brick `b`, and `straddling(c)`
+    /// those of a stencil at voxel `c` across brick faces.
     #[inline(always)]
-    fn trilinear_with(&self, p: Vec3, stored: impl Fn(u32, usize) -> [f32; 8]) -> f32 {
+    fn trilinear_with(
+        &self,
+        p: Vec3,
+        stored: impl Fn(u32, usize) -> [f32; 8],
+        straddling: impl Fn(IVec3) -> [f32; 8],
+    ) -> f32 {
         if !p.is_finite() {
             return 0.0;
         }
@@ -409,7 +409,7 @@ impl BrickVolume {
                 BrickRef::Stored(b) => stored(b, voxel_offset(c.x, c.y, c.z)),
             }
         } else {
-            self.straddling_corners(c)
+            straddling(c)
         };
         lerp_corners(v, f)
     }
@@ -478,7 +478,11 @@ mod tests {
                 - 1.0
                 - volume.origin.as_vec3();
             let fast = volume.trilinear(p);
-            let portable = volume.trilinear_with(p, |b, n| volume.stored_corners(b, n));
+            let portable = volume.trilinear_with(
+                p,
+                |b, n| volume.stored_corners(b, n),
+                |c| volume.straddling_corners(c),
+            );
             assert_eq!(fast.to_bits(), portable.to_bits(), "at {p}");
             positive += usize::from(fast > 0.0);
             straddling += usize::from((p.floor().as_ivec3() & 7).cmpeq(IVec3::splat(7)).any());
