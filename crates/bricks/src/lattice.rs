@@ -13,7 +13,7 @@
 //!   cells: a table read per point, and a step only where the ray enters
 //!   an empty cube (skipped whole). Inside a cloud a ray march at one
 //!   voxel per step crosses a level-1 cell (8 voxels) in a few points, and
-//!   a segment walk's step (locate, bound, exit, merge) cost about as much
+//!   a segment walk's step (locate, bound, exit) cost about as much
 //!   as a lookup per point on the corpus cloud; the table read costs a
 //!   fraction of that.
 //!
@@ -26,6 +26,7 @@ use crate::dda::CellRay;
 use crate::partition::{Cell, CellPartition};
 use crate::segment::MajorantSegment;
 use crate::volume::BrickVolume;
+use crate::voxel_of::voxel_of;
 use crate::CELL_LOG2;
 use glam::Vec3;
 
@@ -122,7 +123,7 @@ impl BrickVolume {
                 return steps;
             }
             let nudge = ray.nudge();
-            let voxel = (ray.origin + ray.dir * (ray.t + nudge)).floor().as_ivec3();
+            let voxel = voxel_of(ray.origin + ray.dir * (ray.t + nudge));
             let c1 = voxel >> C1_SHIFT;
             match partition.cell_at(c1) {
                 Some(Cell::Kept(_)) => break ray.t,
@@ -144,7 +145,7 @@ impl BrickVolume {
                 return steps;
             }
             let p = origin + dir * t;
-            let c1 = p.floor().as_ivec3() >> C1_SHIFT;
+            let c1 = voxel_of(p) >> C1_SHIFT;
             k += 1;
             match partition.cell_at(c1) {
                 Some(Cell::Kept(_)) => {

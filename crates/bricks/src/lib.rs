@@ -37,6 +37,7 @@ mod segment;
 mod stream;
 mod velocity;
 mod volume;
+mod voxel_of;
 
 pub use aabb::{Bounds3, DBounds3};
 pub use bounds::{BoundsLevel, CELL_LOG2, MAX_LEVELS};

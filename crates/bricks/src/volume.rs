@@ -8,6 +8,7 @@ use crate::f16::{f16x8_to_f32_f16c, has_f16c};
 use crate::layout::{voxel_offset, BrickRef, Precision, BRICK_LOG2};
 use crate::partition::CellPartition;
 use crate::section::Section;
+use crate::voxel_of::voxel_of;
 use glam::{DMat4, IVec3, Vec3};
 use std::sync::OnceLock;
 
@@ -399,9 +400,8 @@ impl BrickVolume {
         if !p.is_finite() {
             return 0.0;
         }
-        let f0 = p.floor();
-        let c = f0.as_ivec3();
-        let f = p - f0;
+        let c = voxel_of(p);
+        let f = p - c.as_vec3();
         let v = if (c & 7).cmplt(IVec3::splat(7)).all() {
             match self.brick_ref(c >> BRICK_LOG2 as i32) {
                 BrickRef::Empty => return 0.0,
