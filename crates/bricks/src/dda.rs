@@ -33,7 +33,7 @@
 //! (2% more segments on the corpus cloud without merging), and merging
 //! would cost every walk one step past the segment it ends in (a free
 //! flight ends at its collision, a shadow ray at its roulette), measured
-//! at about 10% of a path-traced render. The ray is
+//! at about 8% of a path-traced render. The ray is
 //! given in local index coordinates of the volume (`BrickVolume::local_from_world`
 //! applied to a world ray): an affine map keeps the ray parameter, so `t`
 //! stays the caller's (world) distance along its direction.
