@@ -16,9 +16,11 @@
 //! `--noise-threshold`, and Open Image Denoise on the finished image (its
 //! time counted; left out, with a note, where the library does not load).
 
+mod ceiling;
+
 use crate::fixed_grid::FixedGridField;
 use crate::BenchResult;
-use cirrus_render::medium::BrickField;
+use ceiling::CollisionCost;
 use cirrus_render::{
     render, Adaptive, Budget, IntegratorKind, MajorantMode, Medium, RenderSettings, SamplerKind,
     Scene, TransmittanceEstimator,
@@ -352,78 +354,11 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
     }
     write_csv(&args.out.join("results.csv"), &rows)?;
     crate::plot::error_vs_time(&args.out.join("error_vs_time.png"), &rows_for_plot(&rows))?;
-    let collision_ns = collision_cost_ns(&scene.medium);
-    let report = report(args, &rows, w, h, collision_ns);
+    let collision = ceiling::collision_cost(&scene.medium);
+    let report = report(args, &rows, w, h, collision);
     crate::write_whole(&args.out.join("report.md"), report.as_bytes())?;
     println!("{report}");
     Ok(())
-}
-
-/// Nanoseconds of one render thread per tentative collision of the
-/// baseline's own trackers over the global majorant: delta tracking (its
-/// free flights) and ratio tracking (its shadow rays, most of its
-/// collisions) along random rays from random points of the medium's
-/// bounds, run on every render thread at once, in the same run as the
-/// renders. A collision's cost is its lookup plus the exponential step,
-/// the random numbers and the test: all of what a perfect majorant would
-/// save.
-///
-/// The shadow rays run to the bounds, so a ray's set-up (a free flight
-/// often ends after a few collisions) is shared by many collisions: timed
-/// with free flights alone, the set-up counted as collision cost put the
-/// corpus cloud's collisions at 63 ns and its ceiling near 17x.
-///
-/// Timed on all threads together, like the renders whose per-path time it
-/// is divided by: on a loaded machine both slow down alike, where a
-/// one-thread timing would run faster than the render threads and make
-/// the ceiling look lower than it is.
-fn collision_cost_ns(medium: &Medium<BrickField>) -> f64 {
-    use cirrus_render::medium::{GlobalMedia, Media};
-    use cirrus_render::stats::Counters;
-    use cirrus_render::tracking::{ratio_tracking, sample_free_flight};
-    use cirrus_render::{Ray, Rng};
-    use rayon::prelude::*;
-    const RAYS_PER_THREAD: u64 = 50_000;
-    let global = GlobalMedia::new(medium);
-    let b = global.bounds();
-    let (lo, hi) = (b.min, b.max);
-    let threads = rayon::current_num_threads() as u64;
-    let mut best = f64::INFINITY;
-    // Best of three: the least disturbed by other work on the machine.
-    for _ in 0..3 {
-        let start = std::time::Instant::now();
-        let collisions: u64 = (0..threads)
-            .into_par_iter()
-            .map(|thread| {
-                let mut c = Counters::default();
-                for k in thread * RAYS_PER_THREAD..(thread + 1) * RAYS_PER_THREAD {
-                    let mut rng = Rng::new(0xC0_111DE, k, 0);
-                    let u = glam::Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
-                    let origin = lo + (hi - lo) * u;
-                    let dir = cirrus_render::sampling::uniform_sphere(rng.uniform(), rng.uniform());
-                    let ray = Ray::new(origin, dir);
-                    std::hint::black_box(sample_free_flight(
-                        &global,
-                        &ray,
-                        f32::INFINITY,
-                        &mut rng,
-                        &mut c,
-                    ));
-                    std::hint::black_box(ratio_tracking(
-                        &global,
-                        &ray,
-                        f32::INFINITY,
-                        &mut rng,
-                        &mut c,
-                    ));
-                }
-                c.real_collisions + c.null_collisions + c.shadow_collisions
-            })
-            .sum();
-        let thread_ns = start.elapsed().as_secs_f64() * 1e9 * threads as f64;
-        best = best.min(thread_ns / collisions.max(1) as f64);
-    }
-    best
 }
 
 fn rows_for_plot(rows: &[Row]) -> Vec<(String, Vec<(f64, f64)>)> {
@@ -463,8 +398,8 @@ fn write_csv(path: &Path, rows: &[Row]) -> std::io::Result<()> {
 /// The markdown report: one row per configuration with its error at the
 /// largest budget and its efficiency against the global-majorant baseline
 /// (geometric mean over budgets of MSE_base x t_base / (MSE x t)), then
-/// the ceiling any majorant structure has on this scene (see `ceiling`).
-fn report(args: &ErrorArgs, rows: &[Row], w: u32, h: u32, collision_ns: f64) -> String {
+/// the ceiling any majorant structure has on this scene (`ceiling.rs`).
+fn report(args: &ErrorArgs, rows: &[Row], w: u32, h: u32, collision: CollisionCost) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -517,66 +452,6 @@ fn report(args: &ErrorArgs, rows: &[Row], w: u32, h: u32, collision_ns: f64) -> 
     }
     let _ = writeln!(s, "\nThe biased ray marchers' error flattens at their bias as the budget grows; the unbiased estimators keep falling as 1/sqrt(time).\n");
     let _ = writeln!(s, "![error against time](error_vs_time.png)\n");
-    ceiling(&mut s, rows, BASELINE, collision_ns);
+    ceiling::write(&mut s, rows, BASELINE, collision);
     s
-}
-
-/// What any majorant structure could gain over the baseline on this scene.
-///
-/// Every unbiased configuration samples the same free-flight distribution
-/// (delta tracking is exact whatever the majorant), so their paths carry
-/// nearly the same variance: only the transmittance estimator of shadow
-/// rays differs, which MSE x paths/pixel shows. What a majorant structure
-/// saves is time, and at most the baseline's null and shadow collisions
-/// (its real collisions stay): with a per-collision cost measured in this
-/// run, their share `f` of the baseline's time bounds the speed-up by
-/// 1 / (1 - f).
-fn ceiling(s: &mut String, rows: &[Row], baseline: &str, collision_ns: f64) {
-    let Some(base) = rows.iter().rfind(|r| r.config == baseline) else {
-        return;
-    };
-    let threads = rayon::current_num_threads() as f64;
-    let path_ns = 1e9 * threads / base.paths_per_s.max(1e-9);
-    let removable = base.lookups_per_path - base.real_per_path;
-    let share = removable * collision_ns / path_ns;
-    let unbiased: Vec<&Row> = rows
-        .iter()
-        .filter(|r| r.config.starts_with("delta"))
-        .filter(|r| Some(r.budget) == rows.last().map(|l| l.budget))
-        .collect();
-    let var = |r: &Row| r.mse * r.spp as f64;
-    let best_var = unbiased
-        .iter()
-        .map(|r| var(r))
-        .fold(f64::INFINITY, f64::min);
-    let _ = writeln!(s, "## The ceiling on this scene\n");
-    let _ = writeln!(
-        s,
-        "- The baseline takes {:.1} null and shadow collisions per path (of {:.1} lookups) at {collision_ns:.1} ns each (its own tracker on every render thread at once, measured in this run), out of {path_ns:.0} ns per path per thread: {:.0}% of its time.",
-        removable,
-        base.lookups_per_path,
-        100.0 * share
-    );
-    if share < 1.0 {
-        let speedup = 1.0 / (1.0 - share);
-        let var_gain = var(base) / best_var;
-        let _ = writeln!(
-            s,
-            "- A majorant structure that removed all of them and cost nothing would be at most {speedup:.2}x faster."
-        );
-        let _ = writeln!(
-            s,
-            "- Delta tracking samples the same free flights whatever the majorant, so the unbiased configurations differ in variance only through their shadow-ray estimators: the lowest MSE x paths/pixel among them is the baseline's divided by {var_gain:.2}."
-        );
-        let _ = writeln!(
-            s,
-            "- Efficiency over the baseline is therefore bounded by about {:.1}x on this scene.",
-            speedup * var_gain
-        );
-    } else {
-        let _ = writeln!(
-            s,
-            "- Collisions that need not happen are (about) all of the baseline's time: the gain is bounded only by what the structure itself costs."
-        );
-    }
 }

@@ -5,7 +5,8 @@
 //!   rays, with the ray-level measures in [`measure`] and the baselines in
 //!   [`baseline`] ([`fixed_grid`] renders through the fixed grid);
 //! - [`error`]: run time against error for every estimator and majorant
-//!   structure, against a converged reference, plotted by [`plot`];
+//!   structure, against a converged reference, plotted by [`plot`], with
+//!   the ceiling any majorant structure has on the scene (`error/ceiling.rs`);
 //! - [`stress`]: extreme inputs, each checked for finite images and, where
 //!   one exists, against a closed-form answer.
 //!

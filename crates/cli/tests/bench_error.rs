@@ -64,6 +64,26 @@ fn error_bench_measures_every_configuration_and_reports_the_ceiling() {
         .unwrap_or_else(|| panic!("{report}"));
     assert!(baseline.trim_end().ends_with("| 1.00x |"), "{baseline}");
     assert!(report.contains("## The ceiling on this scene"), "{report}");
+    // The point bound lies within the range the run's own timings span
+    // (the collision's best timing, the last budget's paths).
+    let ceiling = &report[report.find("## The ceiling").unwrap()..];
+    let word_after = |line: &str, key: &str| -> Option<String> {
+        let i = line.find(key)? + key.len();
+        Some(line[i..].split([' ', ':']).next()?.to_string())
+    };
+    let x = |v: &str| v.trim_end_matches('x').parse::<f64>().ok();
+    if let Some(point) = word_after(ceiling, "would be at most ").and_then(|v| x(&v)) {
+        let range = ceiling.lines().find(|l| l.contains(" spans "));
+        let range = range.unwrap_or_else(|| panic!("{ceiling}"));
+        let low = word_after(range, " spans ").and_then(|v| x(&v));
+        let low = low.unwrap_or_else(|| panic!("{range}"));
+        let high = word_after(range, "x to ").unwrap_or_default();
+        assert!(low <= point + 1e-2, "{low} > {point}: {range}");
+        if high != "unbounded" {
+            let high = x(&high).unwrap_or_else(|| panic!("{high}: {range}"));
+            assert!(point <= high + 1e-2, "{point} > {high}: {range}");
+        }
+    }
     let _ = std::fs::remove_dir_all(&out_dir);
 }
 
