@@ -23,9 +23,9 @@ use crate::BenchResult;
 use ceiling::CollisionCost;
 use cirrus_render::{
     render, Adaptive, Budget, IntegratorKind, MajorantMode, Medium, RenderSettings, SamplerKind,
-    Scene, TransmittanceEstimator,
+    Scene, TransmittanceEstimator, Volumes,
 };
-use cirrus_scene::{Scene as SceneFile, SceneFlags};
+use cirrus_scene::{Scene as SceneFile, SceneFlags, VolumeCache};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -234,26 +234,32 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
     std::fs::create_dir_all(&args.out)?;
     let mut file = SceneFile::load(&args.scene.file)?;
     file.apply(&args.scene.overrides());
-    let lone = file.lone()?;
-    let (scene, base) = lone.prepare()?;
-    let (w, h) = lone.settings.res;
+    let mut cache = VolumeCache::default();
+    let prepared = file.prepare(&mut cache, None)?;
+    let (scene, base) = (&prepared.scene, &prepared.settings);
+    let (w, h) = (scene.camera.width(), scene.camera.height());
+    // The same scene again, its fields walked through the fixed grid.
+    let mut fixed_cache = VolumeCache::default();
     let fixed_scene = {
-        let (s, _) = lone.prepare()?;
-        let Scene {
-            medium,
-            camera,
-            lights,
-        } = s;
+        let p = file.prepare(&mut fixed_cache, None)?;
+        let fixed: Vec<Medium<FixedGridField>> = p
+            .scene
+            .media
+            .into_instances()
+            .into_iter()
+            .map(|m| Medium {
+                field: FixedGridField::new(m.field, args.fixed_res),
+                density_scale: m.density_scale,
+                extinction_tint: m.extinction_tint,
+                albedo: m.albedo,
+                phase: m.phase,
+                emission: None,
+            })
+            .collect();
         Scene {
-            medium: Medium {
-                field: FixedGridField::new(medium.field, args.fixed_res),
-                density_scale: medium.density_scale,
-                extinction_tint: medium.extinction_tint,
-                albedo: medium.albedo,
-                phase: medium.phase,
-            },
-            camera,
-            lights,
+            media: Volumes::new(fixed),
+            camera: p.scene.camera,
+            lights: p.scene.lights,
         }
     };
     let settings_for = |c: &Config, budget: Budget, seed: u64| RenderSettings {
@@ -277,7 +283,7 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
         if c.structure == Structure::Fixed {
             render(&fixed_scene, s)
         } else {
-            render(&scene, s)
+            render(scene, s)
         }
     };
 
@@ -354,7 +360,7 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
     }
     write_csv(&args.out.join("results.csv"), &rows)?;
     crate::plot::error_vs_time(&args.out.join("error_vs_time.png"), &rows_for_plot(&rows))?;
-    let collision = ceiling::collision_cost(&scene.medium);
+    let collision = ceiling::collision_cost(&scene.media);
     let report = report(args, &rows, w, h, collision);
     crate::write_whole(&args.out.join("report.md"), report.as_bytes())?;
     println!("{report}");

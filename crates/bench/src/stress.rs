@@ -23,7 +23,7 @@ use cirrus_bricks::{convert, BrickVolume, Precision};
 use cirrus_render::medium::BrickField;
 use cirrus_render::{
     render, Budget, Camera, Environment, Lights, Medium, RenderSettings, RenderStats, Scene, Sun,
-    TransmittanceEstimator,
+    TransmittanceEstimator, Volumes,
 };
 use cirrus_vdb::{Coord, Grid, GridClass, GridTree, MapKind, Transform, Tree};
 use glam::{DMat4, DVec3, Vec3};
@@ -289,7 +289,7 @@ fn run_case(case: &Case) -> Result<(CaseResult, RenderStats), Box<dyn std::error
     };
     let albedo = if case.expected.is_some() { 0.0 } else { 0.8 };
     let scene = Scene {
-        medium: Medium::new(field, case.scale, Vec3::splat(albedo), 0.5),
+        media: Volumes::from(Medium::new(field, case.scale, Vec3::splat(albedo), 0.5)),
         camera,
         lights,
     };

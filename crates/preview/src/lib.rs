@@ -48,7 +48,7 @@ use cirrus_scene::{Error, Result};
 pub use http::MAX_BODY;
 
 use shared::{Info, Shared};
-use source::{FileRenderer, Kind, Source, VolumeRenderer};
+use source::Source;
 
 /// How to run a preview.
 #[derive(Clone, Debug)]
@@ -100,10 +100,7 @@ pub fn start(config: Config) -> Result<Preview> {
         frame::denoiser().map(|d| format!("{} {:?}", d.library().display(), d.version()));
     let info = Info {
         input: config.input.clone(),
-        kind: match source.kind {
-            Kind::Volume { .. } => "volume",
-            Kind::File { .. } => "scene",
-        },
+        kind: source.kind,
         base_res: source.base_res,
         lighting: source.lighting.clone(),
         max_spp: config.max_spp,
@@ -132,9 +129,10 @@ pub fn start(config: Config) -> Result<Preview> {
         ]
     });
     let mut threads = Vec::new();
-    let (s, kind) = (shared.clone(), source.kind);
+    let (s, mut renderer) = (shared.clone(), source.renderer);
+    renderer.aovs = aovs;
     threads.push(spawn("cirrus-preview-render", move || {
-        render_thread(kind, &s, aovs)
+        engine::run(&mut renderer, &s)
     })?);
     let (s, srv) = (shared.clone(), server.clone());
     threads.push(spawn("cirrus-preview-http", move || {
@@ -153,19 +151,6 @@ fn spawn(name: &str, f: impl FnOnce() + Send + 'static) -> Result<JoinHandle<()>
         .name(name.into())
         .spawn(f)
         .map_err(|e| Error::file(format!("cannot start a thread: {e}")))
-}
-
-fn render_thread(kind: Kind, shared: &Shared, aovs: bool) {
-    match kind {
-        Kind::Volume { scene, lone } => match VolumeRenderer::new(scene, &lone, aovs) {
-            Ok(mut r) => engine::run(&mut r, shared),
-            Err(e) => shared.publish(
-                serde_json::json!({"type": "error", "message": e.message}),
-                None,
-            ),
-        },
-        Kind::File { scene } => engine::run(&mut FileRenderer { base: scene }, shared),
-    }
 }
 
 /// `<dir>/<stem>.preview.<ext>` beside the input.

@@ -1,19 +1,19 @@
 //! What is previewed and how one pass of it is rendered.
 //!
-//! A lone volume is read once: its render scene is prepared once and each
-//! pass only rewrites the camera, lights and medium parameters. A scene
-//! file is rendered through [`Scene::render_with`] with the view's
-//! overrides, which reads its files again per pass (the scene library has
-//! no way yet to keep several placed volumes loaded).
+//! A volume file or a scene file is a [`Scene`]; every pass renders it
+//! through the scene library's one road ([`Scene::render_cached`]) with the
+//! view's overrides, and a [`VolumeCache`] keeps the files and grids read
+//! by the first pass for the next ones. So the preview renders exactly
+//! what `cirrus render` renders for the same flags.
 
 use std::path::Path;
 use std::sync::Arc;
 
-use cirrus_render::medium::{BrickField, Extinction};
-use cirrus_render::{render, Camera, Phase, RenderControl, Rendered};
+use cirrus_render::exr_layers::Aov;
+use cirrus_render::{RenderControl, Rendered};
 use cirrus_scene::description::SceneDescription;
-use cirrus_scene::{defaults as d, Error, LoneVolume, Overrides, Result, Scene};
-use glam::{DMat4, DVec3, Vec3};
+use cirrus_scene::{defaults as d, Overrides, Result, Scene, VolumeCache};
+use glam::Vec3;
 
 use crate::view::{sun_angles, CameraView, Lighting, Mode, SunView, View};
 
@@ -25,25 +25,16 @@ pub trait Renderer {
 
 /// An opened input with what the page starts from.
 pub struct Source {
-    pub kind: Kind,
+    /// "volume" or "scene".
+    pub kind: &'static str,
+    pub renderer: SceneRenderer,
     pub view: View,
     pub lighting: Lighting,
     pub base_res: (u32, u32),
 }
 
-pub enum Kind {
-    /// Boxed: a loaded volume is large, and moves to the render thread.
-    Volume {
-        scene: Scene,
-        lone: Box<LoneVolume>,
-    },
-    File {
-        scene: Scene,
-    },
-}
-
 impl Source {
-    /// Opens `path` (a volume is read here, so errors show before the
+    /// Opens `path` (its volumes are read here, so errors show before the
     /// server starts); `res` overrides the scene's resolution.
     pub fn open(path: &Path, res: Option<(u32, u32)>) -> Result<Source> {
         let mut scene = Scene::load(path)?;
@@ -55,44 +46,36 @@ impl Source {
         let base_res = desc.camera.res.unwrap_or(d::RES);
         let lighting = lighting(&desc);
         let mut view = initial_view(&desc);
-        if path.extension().is_some_and(|e| e == "toml") {
-            let (Some(from), Some(to)) = (desc.camera.from, desc.camera.to) else {
-                return Err(Error::input(format!(
-                    "{}: the preview needs the scene's [camera] `from` and `to`",
-                    path.display()
-                )));
-            };
-            view.camera.from = from;
-            view.camera.to = to;
-            return Ok(Source {
-                kind: Kind::File { scene },
-                view,
-                lighting,
-                base_res,
-            });
-        }
-        let lone = scene.lone()?;
+        let mut cache = VolumeCache::default();
         {
             // The library's own camera (framed when none is given) and
             // medium, brought to world space.
-            let (prepared, _) = lone.prepare()?;
-            let centre = lone.centre();
-            let c = &prepared.camera;
+            let prepared = scene.prepare(&mut cache, None)?;
+            let c = &prepared.scene.camera;
+            let world = |p: Vec3| (p.as_dvec3() + prepared.centre).to_array();
+            let (from, to) = match (desc.camera.from, desc.camera.to) {
+                (Some(from), Some(to)) => (from, to),
+                _ => (world(c.from()), world(c.to())),
+            };
             view.camera = CameraView {
-                from: (c.from().as_dvec3() + centre).to_array(),
-                to: (c.to().as_dvec3() + centre).to_array(),
+                from,
+                to,
                 up: c.up().to_array(),
                 fov: c.vfov_degrees(),
             };
-            let m = &prepared.medium;
-            view.density_scale = Some(m.density_scale);
-            view.albedo = Some(m.albedo.x);
-            view.g = Some(desc.volumes[0].g.unwrap_or(d::G));
+            if let [m] = prepared.scene.media.instances() {
+                view.density_scale = Some(m.density_scale);
+                view.albedo = Some(m.albedo.x);
+                view.g = Some(desc.volumes[0].g.unwrap_or(d::G));
+            }
         }
+        let volume = path.extension().is_none_or(|e| e != "toml");
         Ok(Source {
-            kind: Kind::Volume {
-                scene,
-                lone: Box::new(lone),
+            kind: if volume { "volume" } else { "scene" },
+            renderer: SceneRenderer {
+                base: scene,
+                cache,
+                aovs: false,
             },
             view,
             lighting,
@@ -146,84 +129,25 @@ fn lighting(desc: &SceneDescription) -> Lighting {
     }
 }
 
-/// A lone volume's prepared render scene, rewritten per pass.
-pub struct VolumeRenderer<'a> {
-    lone: &'a LoneVolume,
-    base: Scene,
-    centre: DVec3,
-    scene: cirrus_render::Scene<BrickField<'a>>,
-    /// The density scale the majorant cells were refined for.
-    refined_for: f32,
-    /// Keep the albedo AOV (it guides the denoiser).
-    aovs: bool,
-}
-
-impl<'a> VolumeRenderer<'a> {
-    pub fn new(base: Scene, lone: &'a LoneVolume, aovs: bool) -> Result<Self> {
-        let (scene, _) = lone.prepare()?;
-        Ok(VolumeRenderer {
-            lone,
-            base,
-            centre: lone.centre(),
-            refined_for: scene.medium.density_scale,
-            scene,
-            aovs,
-        })
-    }
-}
-
-impl Renderer for VolumeRenderer<'_> {
-    fn render(&mut self, o: &Overrides, control: Arc<RenderControl>) -> Result<Rendered> {
-        // The library resolves the overrides (lights, defaults, checks) as
-        // `cirrus render` would; only the placement is done here.
-        let mut desc = self.base.clone();
-        desc.apply(o);
-        let s = desc.settings()?;
-        let (from, to) = s
-            .look_at
-            .ok_or_else(|| Error::input("the preview always sets a camera"))?;
-        let to_render = |p: DVec3| (p - self.centre).as_vec3();
-        let (w, h) = s.res;
-        self.scene.camera = Camera::new(to_render(from), to_render(to), s.camera_up, s.fov, w, h);
-        self.scene.lights = s.lights.clone();
-        if let Some(rgb) = o.density_scale {
-            let Extinction { scale, tint } = Extinction::split(rgb.vec3());
-            // Cells refined for another scale stay correct bounds, only
-            // less efficient; refine again past a factor of two.
-            let ratio = scale / self.refined_for;
-            if scale > 0.0 && !(0.5..=2.0).contains(&ratio) {
-                self.scene.medium.field =
-                    BrickField::new(&self.lone.volume, DMat4::IDENTITY, self.centre)
-                        .with_refinement(scale, s.refine_optical_depth);
-                self.refined_for = scale;
-            }
-            self.scene.medium.density_scale = scale;
-            self.scene.medium.extinction_tint = tint;
-        }
-        if let Some(a) = o.albedo {
-            self.scene.medium.albedo = a.vec3();
-        }
-        if let Some(g) = o.g {
-            self.scene.medium.phase = Phase::hg(g);
-        }
-        self.scene.validate()?;
-        let mut settings = s.render;
-        settings.control = Some(control);
-        settings.progress = false;
-        settings.aovs = self.aovs;
-        Ok(render(&self.scene, &settings))
-    }
-}
-
-/// A scene file, rendered whole per pass.
-pub struct FileRenderer {
+/// A scene rendered per pass with the view's overrides, its volumes read
+/// once.
+pub struct SceneRenderer {
     pub base: Scene,
+    cache: VolumeCache,
+    /// Keep the albedo AOV (it guides the denoiser).
+    pub aovs: bool,
 }
 
-impl Renderer for FileRenderer {
+impl Renderer for SceneRenderer {
     fn render(&mut self, o: &Overrides, control: Arc<RenderControl>) -> Result<Rendered> {
         let mut scene = self.base.clone();
         scene.apply(o);
-        scene.render_with(Some(control))
+        if self.aovs {
+            scene.apply(&Overrides {
+                aov: Some(vec![Aov::Albedo]),
+                ..Default::default()
+            });
+        }
+        scene.render_cached(&mut self.cache, Some(control))
     }
 }

@@ -8,7 +8,7 @@ use cirrus_render::image_io::{write_exr, write_png};
 use cirrus_render::Bounds3;
 use cirrus_render::{
     render, Budget, Camera, Environment, GridField, IntegratorKind, Lights, Medium, RenderSettings,
-    Scene, Sun,
+    Scene, Sun, Volumes,
 };
 use glam::Vec3;
 
@@ -29,7 +29,7 @@ fn main() -> std::io::Result<()> {
     });
     let bounds = field.bounds_for_framing();
     let scene = Scene {
-        medium: Medium::new(field, 40.0, Vec3::splat(0.98), 0.6),
+        media: Volumes::from(Medium::new(field, 40.0, Vec3::splat(0.98), 0.6)),
         camera: Camera::framing(bounds, size, size),
         lights: Lights {
             sun: Some(Sun::new(Vec3::new(-0.4, -1.0, -0.3), Vec3::splat(3.0), 0.0)),

@@ -9,23 +9,26 @@
 //!   `cirrus-bricks`' own). [`BrickField`] places a brick volume in render
 //!   space; with the `testing` feature the test fields live here too
 //!   (`ConstantBox`, `GridField` with its DDA-walked `MajorantGrid`). A
-//!   [`Medium`] adds density scale, albedo and a [`Phase`] function;
-//!   [`GlobalMedia`] puts one global majorant over any media (Mitsuba's way).
+//!   [`Medium`] adds density scale, albedo, a [`Phase`] function and
+//!   [`Emission`]; [`GlobalMedia`] puts one global majorant over any media
+//!   (Mitsuba's way).
 //! - [`tracking`] turns segments into events: delta-tracked free flights and
 //!   ratio, residual-ratio and track-length transmittance, each with a
-//!   collision cap and Russian roulette.
+//!   collision cap and Russian roulette, written once over a [`Spectrum`]
+//!   (`f32` for grey media, `Vec3` for chromatic ones).
 //! - [`integrator`] turns a camera ray into a [`Sample`]: the unbiased
 //!   [`PathTracer`], the single-scattering [`RayMarcher`], and the two-pass
 //!   [`TwoPassMarcher`] over a cached [`LightGrid`].
-//! - [`render()`] runs an integrator over tiles on rayon into a film of
+//! - [`render()`] runs an integrator over a [`Scene`] (media, camera,
+//!   lights) on tiles on rayon into a film of
 //!   per-pixel means and variances, for a sample count or a time budget,
 //!   and returns the [`Image`] with [`RenderStats`] (and AOVs, and where a
 //!   crop window sits). [`image_io`] writes EXR and PNG files atomically;
 //!   [`exr_layers`] writes AOV layers and crop data windows and merges tiles.
-//! - [`Media`] is what trackers and integrators walk: a lone [`Medium`], or
-//!   [`Volumes`], several instances under a top-level BVH whose extinction
-//!   and majorant segments add where they overlap, each with its own
-//!   albedo, phase and [`Emission`] ([`blackbody`] for temperature grids).
+//! - [`Media`] is what trackers and integrators walk: [`Volumes`], one
+//!   medium or several under a top-level BVH whose extinction and majorant
+//!   segments add where they overlap, each with its own albedo, phase and
+//!   emission ([`blackbody`] for temperature grids).
 //! - [`Camera`], [`light`] (sun and environment, constant or an
 //!   importance-sampled [`EnvMap`] over a [`distribution`]) and the counter-based
 //!   [`Rng`] in [`sampling`] are the supporting pieces. The RNG is keyed by
@@ -57,6 +60,7 @@ pub mod sampling;
 pub mod scene;
 pub mod shutter;
 pub mod sobol;
+pub mod spectrum;
 pub mod stats;
 pub mod tracking;
 pub mod volumes;
@@ -73,17 +77,18 @@ pub use integrator::{
 };
 pub use light::{Environment, Lights, Sun};
 pub use medium::{
-    Bounds3, BrickField, DensityField, Extinction, GlobalMedia, Interaction, MajorantSegment,
-    Media, Medium, Velocity, VelocityUnit,
+    Bounds3, BrickField, DensityField, Emission, Extinction, GlobalMedia, Interaction,
+    MajorantSegment, Media, Medium, MediumError, Velocity, VelocityUnit,
 };
 #[cfg(feature = "testing")]
 pub use medium::{ConstantBox, GridField, MajorantGrid};
 pub use phase::{HenyeyGreenstein, Phase};
 pub use ray::Ray;
-pub use render::{render, render_media, Rendered, Window};
+pub use render::{render, Rendered, Window};
 pub use sampling::{Rng, SampleStream, SamplerKind};
 pub use scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 pub use shutter::Shutter;
+pub use spectrum::Spectrum;
 pub use stats::{Counters, RenderStats};
 pub use tracking::TransmittanceEstimator;
-pub use volumes::{Emission, VolumeInstance, Volumes};
+pub use volumes::Volumes;

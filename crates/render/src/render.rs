@@ -16,7 +16,7 @@ use crate::integrator::{
 };
 use crate::light::Lights;
 use crate::majorant_choice;
-use crate::medium::{DensityField, GlobalMedia, Media};
+use crate::medium::{GlobalMedia, Media};
 use crate::sampling::{Draw, SampleStream, SamplerKind};
 use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 use crate::shutter::Shutter;
@@ -55,18 +55,12 @@ pub struct Window {
 /// pixel's own samples alone, so the image is bit-identical for any
 /// thread count and a crop is bit-identical to the same pixels of the
 /// full image.
-pub fn render<F: DensityField>(scene: &Scene<F>, settings: &RenderSettings) -> Rendered {
-    render_media(&scene.medium, &scene.camera, &scene.lights, settings)
-}
-
-/// [`render`] for any [`Media`]: a lone medium or several volume
-/// instances ([`Volumes`](crate::volumes::Volumes)).
-pub fn render_media<M: Media>(
-    media: &M,
-    camera: &Camera,
-    lights: &Lights,
-    settings: &RenderSettings,
-) -> Rendered {
+pub fn render<M: Media>(scene: &Scene<M>, settings: &RenderSettings) -> Rendered {
+    let Scene {
+        media,
+        camera,
+        lights,
+    } = scene;
     let start = Instant::now();
     let (mode, probe) = majorant_choice::choose(media, camera, lights, settings);
     let mut r = match mode {

@@ -10,14 +10,15 @@ use crate::camera::Camera;
 use crate::control::RenderControl;
 use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::light::Lights;
-use crate::medium::Medium;
 use crate::sampling::SamplerKind;
 use crate::shutter::Shutter;
 use crate::tracking::TransmittanceEstimator;
 
-/// A volume, a camera and lights at infinity, all in render space.
-pub struct Scene<F> {
-    pub medium: Medium<F>,
+/// What is rendered, all in render space: the media (a lone medium or
+/// several, as [`Volumes`](crate::Volumes)), a camera and lights at
+/// infinity.
+pub struct Scene<M> {
+    pub media: M,
     pub camera: Camera,
     pub lights: Lights,
 }
@@ -192,23 +193,6 @@ impl RenderSettings {
         }
         if let Some(a) = &self.adaptive {
             a.validate()?;
-        }
-        Ok(())
-    }
-}
-
-impl<F> Scene<F> {
-    /// Checks the medium's parameters.
-    pub fn validate(&self) -> Result<(), String> {
-        let m = &self.medium;
-        if !(m.density_scale.is_finite() && m.density_scale >= 0.0) {
-            return Err(format!(
-                "density scale must be finite and >= 0, got {}",
-                m.density_scale
-            ));
-        }
-        if !m.albedo.is_finite() || m.albedo.min_element() < 0.0 || m.albedo.max_element() > 1.0 {
-            return Err(format!("albedo must lie in [0, 1], got {}", m.albedo));
         }
         Ok(())
     }

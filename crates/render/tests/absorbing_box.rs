@@ -4,7 +4,7 @@
 mod common;
 
 use cirrus_render::Bounds3;
-use cirrus_render::{render, Camera, ConstantBox, IntegratorKind, Lights, Medium, Scene};
+use cirrus_render::{render, Camera, ConstantBox, IntegratorKind, Lights, Medium, Scene, Volumes};
 use glam::Vec3;
 
 /// Average of `exp(-sigma d(x))` over the pixel's footprint by an m x m
@@ -54,7 +54,7 @@ fn absorbing_box_matches_beer_lambert() {
         size,
     );
     let scene = Scene {
-        medium: Medium::new(b, sigma, Vec3::ZERO, 0.3),
+        media: Volumes::from(Medium::new(b, sigma, Vec3::ZERO, 0.3)),
         camera,
         lights: Lights {
             sun: None,

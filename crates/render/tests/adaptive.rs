@@ -5,11 +5,11 @@ mod common;
 
 use cirrus_render::{
     render, Adaptive, Budget, Crop, GridField, IntegratorKind, Lights, RenderSettings, Rendered,
-    SamplerKind, Scene,
+    SamplerKind, Scene, Volumes,
 };
 use glam::Vec3;
 
-fn cloud(size: u32, sun: bool) -> Scene<GridField> {
+fn cloud(size: u32, sun: bool) -> Scene<Volumes<GridField>> {
     let lights = Lights {
         sun: if sun { common::sun(2.0) } else { None },
         environment: common::env(Vec3::new(0.2, 0.3, 0.45)),

@@ -10,13 +10,13 @@
 
 mod common;
 
-use cirrus_render::medium::{Extinction, Interaction};
-use cirrus_render::tracking::spectral::{sample_free_flight_spectral, transmittance_rgb};
-use cirrus_render::tracking::FreeFlight;
+use cirrus_render::medium::{Extinction, Interaction, Lattice};
+use cirrus_render::tracking::{sample_free_flight, transmittance, FreeFlight};
 use cirrus_render::{
-    render, render_media, Bounds3, Camera, ConstantBox, Counters, IntegratorKind, Lights, Media,
-    Medium, Ray, Rng, Scene, TransmittanceEstimator, VolumeInstance, Volumes,
+    render, Bounds3, Camera, ConstantBox, Counters, IntegratorKind, Lights, Media, Medium, Ray,
+    Rng, Scene, Spectrum, TransmittanceEstimator, Volumes,
 };
+use common::render_through;
 use glam::Vec3;
 
 /// Mean and standard error of each channel of `n` draws.
@@ -33,12 +33,12 @@ fn mean_and_error(n: u32, mut draw: impl FnMut(u32) -> Vec3) -> (Vec3, Vec3) {
     (mean.as_vec3(), (var / n).as_vec3().map(f32::sqrt))
 }
 
-fn rgb_box() -> (Medium<ConstantBox>, Vec3) {
+fn rgb_box() -> (Volumes<ConstantBox>, Vec3) {
     let b = ConstantBox::new(Vec3::splat(-0.5), Vec3::splat(0.5), 1.0, 0.05);
     let sigma = Vec3::new(1.6, 0.8, 0.16);
     let e = Extinction::split(sigma);
     let medium = Medium::new(b, e.scale, Vec3::ZERO, 0.0).with_extinction_tint(e.tint);
-    (medium, sigma)
+    (Volumes::from(medium), sigma)
 }
 
 #[test]
@@ -70,7 +70,7 @@ fn rgb_absorbing_box_matches_beer_lambert_per_channel() {
         let mut c = Counters::default();
         let r = mean_and_error(n, |i| {
             let mut rng = Rng::new(3, u64::from(i), 0);
-            transmittance_rgb(est, &medium, &ray, f32::INFINITY, &mut rng, &mut c)
+            transmittance::<Vec3, _>(est, &medium, &ray, f32::INFINITY, &mut rng, &mut c)
         });
         check(est.name(), r);
         assert_eq!(c.majorant_violations, 0);
@@ -80,8 +80,14 @@ fn rgb_absorbing_box_matches_beer_lambert_per_channel() {
     let r = mean_and_error(n, |i| {
         let mut rng = Rng::new(5, u64::from(i), 0);
         let mut beta = Vec3::ONE;
-        match sample_free_flight_spectral(&medium, &ray, f32::INFINITY, &mut beta, &mut rng, &mut c)
-        {
+        match sample_free_flight::<Vec3, _>(
+            &medium,
+            &ray,
+            f32::INFINITY,
+            &mut beta,
+            &mut rng,
+            &mut c,
+        ) {
             FreeFlight::Escaped => beta,
             _ => Vec3::ZERO,
         }
@@ -92,7 +98,7 @@ fn rgb_absorbing_box_matches_beer_lambert_per_channel() {
 #[test]
 fn rgb_absorbing_box_renders_beer_lambert_per_channel() {
     let (medium, sigma) = rgb_box();
-    let b = medium.field;
+    let b = medium.instances()[0].field;
     let l_env = Vec3::new(1.0, 0.8, 0.5);
     let size = 16;
     let camera = Camera::new(
@@ -104,7 +110,7 @@ fn rgb_absorbing_box_renders_beer_lambert_per_channel() {
         size,
     );
     let scene = Scene {
-        medium,
+        media: medium,
         camera,
         lights: Lights {
             sun: None,
@@ -163,11 +169,25 @@ impl<M: Media> Media for ForceChromatic<M> {
     fn majorants(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> Self::Majorants<'_> {
         self.0.majorants(o, d, t0, t1)
     }
-    fn sigma_t(&self, p: Vec3) -> f32 {
-        self.0.sigma_t(p)
+    fn extinction<S: Spectrum>(&self, p: Vec3, time: f32) -> S {
+        self.0.extinction(p, time)
     }
     fn chromatic(&self) -> bool {
         true
+    }
+    /// Each channel looked up, as for a mixture of tints.
+    fn uniform_tint(&self) -> Option<Vec3> {
+        None
+    }
+    fn march_lattice(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        self.0.march_lattice(o, d, t_max, lattice, visit)
     }
     fn bounds(&self) -> Bounds3 {
         self.0.bounds()
@@ -178,31 +198,37 @@ impl<M: Media> Media for ForceChromatic<M> {
     fn max_sigma_t(&self) -> f32 {
         self.0.max_sigma_t()
     }
-    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
-        self.0.interaction(p, rng)
+    fn interaction(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
+        self.0.interaction(p, time, rng)
+    }
+    fn emits(&self) -> bool {
+        self.0.emits()
+    }
+    fn emission(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
+        self.0.emission(p, time, instance, c)
     }
 }
 
-fn cloud_scene() -> (Medium<cirrus_render::GridField>, Camera, Lights) {
+fn cloud_scene() -> (Volumes<cirrus_render::GridField>, Camera, Lights) {
     let medium = common::medium(common::cloud_field(4), 12.0, 0.9, 0.5);
     let lights = Lights {
         sun: common::sun(0.0),
         environment: common::env(Vec3::new(0.3, 0.4, 0.6)),
     };
     let s = common::scene(medium, 24, lights);
-    (s.medium, s.camera, s.lights)
+    (s.media, s.camera, s.lights)
 }
 
 #[test]
 fn equal_channels_through_spectral_tracking_agree_with_grey() {
     let (medium, camera, lights) = cloud_scene();
     let settings = common::settings(IntegratorKind::Path, 64, 21);
-    let grey = render_media(&medium, &camera, &lights, &settings);
+    let grey = render_through(&medium, &camera, &lights, &settings);
     let forced = ForceChromatic(medium);
     // With equal channels spectral tracking takes delta tracking's
     // decisions from the same numbers, its weights 1 up to rounding: with
     // the same seed the images match to rounding...
-    let same_seed = render_media(&forced, &camera, &lights, &settings);
+    let same_seed = render_through(&forced, &camera, &lights, &settings);
     assert_ne!(
         grey.image.rgba, same_seed.image.rgba,
         "the spectral code ran"
@@ -217,7 +243,7 @@ fn equal_channels_through_spectral_tracking_agree_with_grey() {
     }
     // ...and with another seed they agree within noise.
     let settings = common::settings(IntegratorKind::Path, 64, 22);
-    let spectral = render_media(&forced, &camera, &lights, &settings);
+    let spectral = render_through(&forced, &camera, &lights, &settings);
     for c in 0..4 {
         let mut d = common::differences(&grey.image, &spectral.image, c);
         // Where every grey sample escaped (variance 0), the spectral
@@ -242,9 +268,9 @@ fn equal_channels_through_the_rgb_march_are_the_grey_march() {
     let (medium, camera, lights) = cloud_scene();
     let mut settings = common::settings(IntegratorKind::RayMarch, 4, 8);
     settings.step_voxels = 1.0;
-    let grey = render_media(&medium, &camera, &lights, &settings);
+    let grey = render_through(&medium, &camera, &lights, &settings);
     let forced = ForceChromatic(medium);
-    let rgb = render_media(&forced, &camera, &lights, &settings);
+    let rgb = render_through(&forced, &camera, &lights, &settings);
     for (a, b) in grey.image.rgba.iter().zip(&rgb.image.rgba) {
         assert_eq!(a[..3], b[..3]);
         assert!((a[3] - b[3]).abs() <= 1e-6);
@@ -253,25 +279,25 @@ fn equal_channels_through_the_rgb_march_are_the_grey_march() {
 
 #[test]
 fn overlapping_chromatic_instances_render_as_their_sum() {
-    let (medium, camera, lights) = cloud_scene();
-    let field = medium.field;
+    let (_, camera, lights) = cloud_scene();
+    let field = common::cloud_field(4);
     let (a, b) = (Vec3::new(1.0, 0.4, 0.2), Vec3::new(0.3, 1.0, 0.6));
     let (sa, sb) = (7.0, 5.0);
     let albedo = Vec3::new(0.95, 0.9, 0.8);
     let instance = |scale: f32, tint: Vec3| {
-        VolumeInstance::new(field.clone(), scale, albedo, 0.5).with_extinction_tint(tint)
+        Medium::new(field.clone(), scale, albedo, 0.5).with_extinction_tint(tint)
     };
     let pair = Volumes::new(vec![instance(sa, a), instance(sb, b)]);
     let sum = Extinction::split(sa * a + sb * b);
     let one = Volumes::new(vec![instance(sum.scale, sum.tint)]);
     assert!(pair.chromatic() && one.chromatic());
-    let r_pair = render_media(
+    let r_pair = render_through(
         &pair,
         &camera,
         &lights,
         &common::settings(IntegratorKind::Path, 64, 33),
     );
-    let r_one = render_media(
+    let r_one = render_through(
         &one,
         &camera,
         &lights,

@@ -8,8 +8,7 @@ mod common;
 use cirrus_render::blackbody::blackbody_rgb;
 use cirrus_render::Bounds3;
 use cirrus_render::{
-    render_media, Blackbody, Camera, ConstantBox, Emission, IntegratorKind, Lights, VolumeInstance,
-    Volumes,
+    Blackbody, Camera, ConstantBox, Emission, IntegratorKind, Lights, Medium, Volumes,
 };
 use glam::Vec3;
 
@@ -42,9 +41,8 @@ fn footprint_opacity(cam: &Camera, b: &ConstantBox, sigma: f32, x: u32, y: u32, 
 
 fn check(label: &str, emission: Emission<ConstantBox>, le: Vec3) {
     let sigma = 1.5;
-    let mut inst = VolumeInstance::new(unit_box(1.0), sigma, Vec3::ZERO, 0.0);
-    inst.emission = Some(emission);
-    let volumes = Volumes::new(vec![inst]);
+    let volumes =
+        Volumes::from(Medium::new(unit_box(1.0), sigma, Vec3::ZERO, 0.0).with_emission(emission));
     let size = 20;
     let spp = 256;
     let camera = Camera::new(
@@ -57,7 +55,7 @@ fn check(label: &str, emission: Emission<ConstantBox>, le: Vec3) {
     );
     let mut settings = common::settings(IntegratorKind::Path, spp, 11);
     settings.aovs = true;
-    let out = render_media(&volumes, &camera, &Lights::default(), &settings);
+    let out = common::render_through(&volumes, &camera, &Lights::default(), &settings);
     assert!(out.stats.counters.emission_lookups > 0, "{label}");
     // All the light is emitted: the emission AOV is the beauty, exactly;
     // nothing is scattered; albedo 0; every pixel took every sample; and

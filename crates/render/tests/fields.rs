@@ -151,7 +151,7 @@ fn global_media_collapse_to_one_segment() {
     let f = common::cloud_field(4);
     let max = f.global_majorant();
     let Bounds3 { min: lo, max: hi } = f.bounds();
-    let medium = Medium::new(f, 2.0, Vec3::ONE, 0.0);
+    let medium = cirrus_render::Volumes::from(Medium::new(f, 2.0, Vec3::ONE, 0.0));
     let g = GlobalMedia::new(&medium);
     for (o, d, t_min, t_max) in test_rays(lo, hi, 100) {
         let segs: Vec<_> = g.majorants(o, d, t_min, t_max).collect();

@@ -10,7 +10,7 @@ use cirrus_render::medium::BrickField;
 use cirrus_render::tracking::ratio_tracking;
 use cirrus_render::{
     render, Budget, Camera, Counters, DensityField, Environment, Lights, Medium, Ray,
-    RenderSettings, Rng, Scene, Shutter, Velocity, VelocityUnit,
+    RenderSettings, Rng, Scene, Shutter, Velocity, VelocityUnit, Volumes,
 };
 use cirrus_vdb::{Coord, Tree};
 use glam::{DMat4, DVec3, Vec3};
@@ -66,12 +66,12 @@ fn closed_form() -> f64 {
     (1.5 * (-k).exp() + (1.0 - (-k).exp()) / k + 0.5) / 3.0
 }
 
-fn moving_box(volume: &BrickVolume) -> Medium<BrickField<'_>> {
+fn moving_box(volume: &BrickVolume) -> Volumes<BrickField<'_>> {
     let field = BrickField::new(volume, DMat4::IDENTITY, DVec3::ZERO)
         .with_motion(&constant_velocity([V, 0.0, 0.0]), SHUTTER)
         .unwrap();
     // The y profile integrates to 8 voxels: K = 8 * density scale.
-    Medium::new(field, K / 8.0, Vec3::ZERO, 0.0)
+    Volumes::from(Medium::new(field, K / 8.0, Vec3::ZERO, 0.0))
 }
 
 #[test]
@@ -85,7 +85,7 @@ fn constant_velocity_box_matches_the_time_averaged_transmittance() {
         let mut rng = Rng::new(7, i, 0);
         let time = SHUTTER.open + (SHUTTER.close - SHUTTER.open) * rng.uniform();
         let ray = Ray::new(Vec3::new(X0, -20.0, 8.0), Vec3::Y).with_time(time);
-        let tr = ratio_tracking(&medium, &ray, f32::INFINITY, &mut rng, &mut c) as f64;
+        let tr = ratio_tracking::<f32, _>(&medium, &ray, f32::INFINITY, &mut rng, &mut c) as f64;
         sum += tr;
         sum2 += tr * tr;
     }
@@ -122,7 +122,7 @@ fn a_rendered_pixel_sees_the_time_averaged_transmittance() {
         environment: Some(Environment::new(Vec3::ONE)),
     };
     let scene = Scene {
-        medium,
+        media: medium,
         camera,
         lights,
     };
@@ -252,7 +252,7 @@ fn majorants_bound_the_moving_density_at_every_time() {
 fn a_closed_shutter_or_no_velocity_renders_bit_identical() {
     let (volume, velocity) = blob_and_swirl();
     let render_with = |field: BrickField<'_>, shutter: Shutter| {
-        let medium = Medium::new(field, 0.4, Vec3::splat(0.9), 0.5);
+        let medium = Volumes::from(Medium::new(field, 0.4, Vec3::splat(0.9), 0.5));
         let camera = Camera::new(
             Vec3::new(20.0, 25.0, -40.0),
             Vec3::splat(20.0),
@@ -270,7 +270,7 @@ fn a_closed_shutter_or_no_velocity_renders_bit_identical() {
             environment: Some(Environment::new(Vec3::new(0.2, 0.3, 0.4))),
         };
         let scene = Scene {
-            medium,
+            media: medium,
             camera,
             lights,
         };

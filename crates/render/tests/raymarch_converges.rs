@@ -3,7 +3,7 @@
 
 mod common;
 
-use cirrus_render::{render, GridField, Image, IntegratorKind, Lights, Scene};
+use cirrus_render::{render, GridField, Image, IntegratorKind, Lights, Scene, Volumes};
 use glam::Vec3;
 
 /// Squared bias of `a` against the reference `b` in one channel, corrected
@@ -25,7 +25,7 @@ fn squared_bias(a: &Image, b: &Image) -> (f64, f64) {
     (excess, noise)
 }
 
-fn scene() -> Scene<GridField> {
+fn scene() -> Scene<Volumes<GridField>> {
     // Dense enough (peak optical depth ~12) that coarse steps are visibly
     // wrong; a delta sun and a sky, so both shadow-ray kinds are exercised.
     let lights = Lights {
@@ -92,7 +92,7 @@ fn light_grid_stores_only_bricks_near_density() {
             0.0
         }
     });
-    let medium = common::medium(field, 10.0, 0.9, 0.0);
+    let medium = Volumes::from(common::medium(field, 10.0, 0.9, 0.0));
     let lights = Lights {
         sun: common::sun(0.0),
         environment: None,

@@ -6,7 +6,7 @@ mod common;
 use cirrus_render::image_io::{tonemap, write_exr, write_png};
 use cirrus_render::{
     render, ConstantBox, Counters, DensityField, IntegratorKind, Lights, MajorantSegment, Medium,
-    Scene, TransmittanceEstimator,
+    Scene, TransmittanceEstimator, Volumes,
 };
 use glam::Vec3;
 
@@ -48,7 +48,7 @@ impl DensityField for Broken {
     }
 }
 
-fn broken_scene(density: f32, majorant: f32, size: u32) -> Scene<Broken> {
+fn broken_scene(density: f32, majorant: f32, size: u32) -> Scene<Volumes<Broken>> {
     let inner = ConstantBox::new(Vec3::splat(-0.5), Vec3::splat(0.5), 1.0, 0.1);
     let medium = Medium::new(
         Broken {
@@ -66,7 +66,7 @@ fn broken_scene(density: f32, majorant: f32, size: u32) -> Scene<Broken> {
     };
     let camera = cirrus_render::Camera::framing(medium.field.bounds(), size, size);
     Scene {
-        medium,
+        media: medium.into(),
         camera,
         lights,
     }
@@ -84,7 +84,7 @@ const ALL: [(IntegratorKind, TransmittanceEstimator); 5] = [
 /// returns the summed counters.
 fn assert_finite(
     label: &str,
-    scene: &Scene<Broken>,
+    scene: &Scene<Volumes<Broken>>,
     configs: &[(IntegratorKind, TransmittanceEstimator)],
 ) -> Counters {
     let mut total = Counters::default();

@@ -5,6 +5,7 @@ mod common;
 
 use cirrus_render::{
     render, Bounds3, Camera, ConstantBox, IntegratorKind, Lights, Medium, SamplerKind, Scene,
+    Volumes,
 };
 use glam::Vec3;
 
@@ -52,7 +53,12 @@ fn sobol_beats_random_on_an_absorbing_box() {
         size,
     );
     let scene = Scene {
-        medium: Medium::new(ConstantBox::new(lo, hi, 1.0, 0.05), sigma, Vec3::ZERO, 0.3),
+        media: Volumes::from(Medium::new(
+            ConstantBox::new(lo, hi, 1.0, 0.05),
+            sigma,
+            Vec3::ZERO,
+            0.3,
+        )),
         camera,
         lights: Lights {
             sun: None,

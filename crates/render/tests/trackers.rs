@@ -8,7 +8,9 @@ use cirrus_render::tracking::{
     transmittance, FreeFlight, TransmittanceEstimator,
 };
 use cirrus_render::Bounds3;
-use cirrus_render::{ConstantBox, Counters, DensityField, GlobalMedia, Medium, Ray, Rng};
+use cirrus_render::{
+    ConstantBox, Counters, DensityField, GlobalMedia, Media, Medium, Ray, Rng, Volumes,
+};
 use glam::Vec3;
 
 const ESTIMATORS: [TransmittanceEstimator; 3] = [
@@ -44,12 +46,12 @@ fn chord_ray() -> Ray {
 fn estimators_match_exp_on_a_constant_box() {
     // Optical depths from thin to thick; RR kicks in for the last.
     for sigma in [0.2f32, 1.0, 2.5, 6.0] {
-        let medium = Medium::new(unit_box(1.0), sigma, Vec3::ONE, 0.0);
+        let medium = Volumes::from(Medium::new(unit_box(1.0), sigma, Vec3::ONE, 0.0));
         let exact = (-sigma as f64).exp();
         for est in ESTIMATORS {
             let mut c = Counters::default();
             let (mean, se) = estimate(20_000, 1, |rng| {
-                transmittance(est, &medium, &chord_ray(), f32::INFINITY, rng, &mut c)
+                transmittance::<f32, _>(est, &medium, &chord_ray(), f32::INFINITY, rng, &mut c)
             });
             // 5 standard errors; with se = 0 (an exact estimator) only f32
             // rounding of exp is allowed.
@@ -68,7 +70,7 @@ fn estimators_match_exp_on_a_constant_box() {
 fn residual_tracking_is_exact_where_the_majorant_is_tight() {
     // Constant segment: sigma_maj == sigma_c, no collisions, every estimate
     // is exp(-sigma d) itself (up to f32 rounding).
-    let medium = Medium::new(unit_box(1.0), 1.7, Vec3::ONE, 0.0);
+    let medium = Volumes::from(Medium::new(unit_box(1.0), 1.7, Vec3::ONE, 0.0));
     let mut c = Counters::default();
     for i in 0..100 {
         let mut rng = Rng::new(2, i, 0);
@@ -81,12 +83,12 @@ fn residual_tracking_is_exact_where_the_majorant_is_tight() {
 #[test]
 fn t_max_limits_the_estimate() {
     // Stopping at t = 1.25 leaves a chord of 0.75 inside the box.
-    let medium = Medium::new(unit_box(1.0), 2.0, Vec3::ONE, 0.0);
+    let medium = Volumes::from(Medium::new(unit_box(1.0), 2.0, Vec3::ONE, 0.0));
     let exact = (-2.0f64 * 0.75).exp();
     for est in ESTIMATORS {
         let mut c = Counters::default();
         let (mean, se) = estimate(20_000, 3, |rng| {
-            transmittance(est, &medium, &chord_ray(), 1.25, rng, &mut c)
+            transmittance::<f32, _>(est, &medium, &chord_ray(), 1.25, rng, &mut c)
         });
         assert!(
             (mean - exact).abs() <= 5.0 * se + 1e-6,
@@ -98,8 +100,8 @@ fn t_max_limits_the_estimate() {
 /// Transmittance by midpoint quadrature in f64 over the ray's overlap
 /// with the field; 20 000 steps over at most ~2 units of a field with
 /// 1/16-unit voxels: the error is far below the Monte Carlo tolerance.
-fn quadrature_transmittance<F: DensityField>(medium: &Medium<F>, ray: &Ray) -> f64 {
-    let Bounds3 { min: lo, max: hi } = medium.field.bounds();
+fn quadrature_transmittance<M: Media>(medium: &M, ray: &Ray) -> f64 {
+    let Bounds3 { min: lo, max: hi } = medium.bounds();
     let Some((t0, t1)) = Bounds3::new(lo, hi).clip_ray(ray.origin, ray.dir, 0.0, f32::INFINITY)
     else {
         return 1.0;
@@ -107,7 +109,10 @@ fn quadrature_transmittance<F: DensityField>(medium: &Medium<F>, ray: &Ray) -> f
     let n = 20_000;
     let h = (t1 - t0) as f64 / n as f64;
     let tau: f64 = (0..n)
-        .map(|i| medium.sigma_t(ray.at((t0 as f64 + (i as f64 + 0.5) * h) as f32)) as f64 * h)
+        .map(|i| {
+            let p = ray.at((t0 as f64 + (i as f64 + 0.5) * h) as f32);
+            medium.extinction::<f32>(p, 0.0) as f64 * h
+        })
         .sum();
     (-tau).exp()
 }
@@ -117,7 +122,7 @@ fn estimators_match_quadrature_on_a_grid_field_with_both_majorant_modes() {
     let field = common::cloud_field(4);
     let Bounds3 { min: lo, max: hi } = field.bounds();
     let centre = 0.5 * (lo + hi);
-    let medium = Medium::new(field, 6.0, Vec3::ONE, 0.0);
+    let medium = Volumes::from(Medium::new(field, 6.0, Vec3::ONE, 0.0));
     let global = GlobalMedia::new(&medium);
     let rays = [
         Ray::new(
@@ -136,10 +141,10 @@ fn estimators_match_quadrature_on_a_grid_field_with_both_majorant_modes() {
         for est in ESTIMATORS {
             let mut c = Counters::default();
             let (m_local, se_local) = estimate(20_000, 10 + r as u64, |rng| {
-                transmittance(est, &medium, ray, f32::INFINITY, rng, &mut c)
+                transmittance::<f32, _>(est, &medium, ray, f32::INFINITY, rng, &mut c)
             });
             let (m_global, se_global) = estimate(20_000, 20 + r as u64, |rng| {
-                transmittance(est, &global, ray, f32::INFINITY, rng, &mut c)
+                transmittance::<f32, _>(est, &global, ray, f32::INFINITY, rng, &mut c)
             });
             for (mode, m, se) in [
                 ("local", m_local, se_local),
@@ -161,10 +166,11 @@ fn delta_tracking_samples_exponential_flights() {
     // sigma, truncated at the chord d = 1, so P(escape) = exp(-sigma) and
     // E[min(s, d)] = (1 - exp(-sigma d)) / sigma.
     let sigma = 1.3f32;
-    let medium = Medium::new(unit_box(1.0), sigma, Vec3::ONE, 0.0);
+    let medium = Volumes::from(Medium::new(unit_box(1.0), sigma, Vec3::ONE, 0.0));
     let mut c = Counters::default();
     let flight = |rng: &mut Rng, c: &mut Counters| {
-        sample_free_flight(&medium, &chord_ray(), f32::INFINITY, rng, c)
+        let mut beta = Vec3::ONE;
+        sample_free_flight::<f32, _>(&medium, &chord_ray(), f32::INFINITY, &mut beta, rng, c)
     };
     let (escape, se_e) = estimate(40_000, 4, |rng| {
         (flight(rng, &mut c) == FreeFlight::Escaped) as u8 as f32
@@ -185,13 +191,13 @@ fn delta_tracking_samples_exponential_flights() {
 
 #[test]
 fn track_length_and_ratio_agree_through_the_public_functions() {
-    let medium = Medium::new(unit_box(1.0), 0.8, Vec3::ONE, 0.0);
+    let medium = Volumes::from(Medium::new(unit_box(1.0), 0.8, Vec3::ONE, 0.0));
     let mut c = Counters::default();
     let (a, se_a) = estimate(20_000, 6, |rng| {
-        ratio_tracking(&GlobalMedia::new(&medium), &chord_ray(), 9.0, rng, &mut c)
+        ratio_tracking::<f32, _>(&GlobalMedia::new(&medium), &chord_ray(), 9.0, rng, &mut c)
     });
     let (b, se_b) = estimate(20_000, 7, |rng| {
-        track_length_transmittance(&medium, &chord_ray(), 9.0, rng, &mut c)
+        track_length_transmittance::<f32, _>(&medium, &chord_ray(), 9.0, rng, &mut c)
     });
     assert!((a - b).abs() <= 5.0 * (se_a * se_a + se_b * se_b).sqrt());
 }

@@ -1,11 +1,12 @@
-//! Several volume instances: overlapping copies add, the one-instance fast
-//! path is the lone-medium renderer, and empty space costs nothing.
+//! Several volume instances: overlapping copies add, one instance walks
+//! its own segments (no BVH, no merge), and empty space costs nothing.
 
 mod common;
 
+use cirrus_render::medium::Scaled;
 use cirrus_render::{
-    render, render_media, ConstantBox, IntegratorKind, Lights, TransmittanceEstimator,
-    VolumeInstance, Volumes,
+    render, ConstantBox, DensityField, IntegratorKind, Lights, Media, Medium, Ray, Rng,
+    TransmittanceEstimator, Volumes,
 };
 use glam::Vec3;
 
@@ -39,11 +40,11 @@ fn two_half_density_copies_render_as_one_full_copy() {
         let single = render(&scene, &settings);
 
         let copies = Volumes::new(vec![
-            VolumeInstance::new(common::cloud_field(4), 0.5 * scale, Vec3::splat(a1), g),
-            VolumeInstance::new(common::cloud_field(3), 0.5 * scale, Vec3::splat(a2), g),
+            Medium::new(common::cloud_field(4), 0.5 * scale, Vec3::splat(a1), g),
+            Medium::new(common::cloud_field(3), 0.5 * scale, Vec3::splat(a2), g),
         ]);
         settings.seed += 1000;
-        let double = render_media(&copies, &scene.camera, &scene.lights, &settings);
+        let double = common::render_through(&copies, &scene.camera, &scene.lights, &settings);
         for out in [&single, &double] {
             assert_eq!(
                 out.stats.counters.nonfinite_samples + out.stats.counters.collision_cap_hits,
@@ -76,33 +77,38 @@ fn two_half_density_copies_render_as_one_full_copy() {
     }
 }
 
-/// One instance takes the fast path: the same segments, lookups and random
-/// numbers as the lone medium, so the same image bit for bit.
+/// One instance takes the fast path, no BVH and no merge: along any ray
+/// its segments are its field's own, scaled, bit for bit, and so is its
+/// extinction.
 #[test]
-fn one_instance_is_the_lone_medium_bit_for_bit() {
-    let medium = common::medium(common::cloud_field(4), 6.0, 0.9, 0.5);
-    let scene = common::scene(medium, 12, lights());
-    let settings = common::settings(IntegratorKind::Path, 8, 5);
-    let lone = render(&scene, &settings);
-    let volumes = Volumes::new(vec![VolumeInstance::new(
+fn one_instance_walks_its_own_segments() {
+    let volumes = Volumes::from(Medium::new(
         common::cloud_field(4),
         6.0,
         Vec3::splat(0.9),
         0.5,
-    )]);
-    let inst = render_media(&volumes, &scene.camera, &scene.lights, &settings);
-    assert_eq!(lone.image, inst.image);
-    assert_eq!(
-        lone.stats.counters.density_lookups,
-        inst.stats.counters.density_lookups
-    );
+    ));
+    let field = common::cloud_field(4);
+    let mut rng = Rng::new(9, 0, 0);
+    let mut segments = 0;
+    for _ in 0..200 {
+        let o = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+        let d = cirrus_render::sampling::uniform_sphere(rng.uniform(), rng.uniform());
+        let ours: Vec<_> = volumes.majorants(o, d, 0.0, f32::INFINITY).collect();
+        let own: Vec<_> = Scaled::new(field.segments(o, d, 0.0, f32::INFINITY), 6.0).collect();
+        assert_eq!(ours, own);
+        segments += own.len();
+        let p = Ray::new(o, d).at(0.2);
+        assert_eq!(volumes.extinction::<f32>(p, 0.0), 6.0 * field.density(p));
+    }
+    assert!(segments > 200, "only {segments} segments");
 }
 
 /// Rays that miss every instance do no tracking: no segments, no lookups.
 #[test]
 fn rays_that_miss_every_volume_do_no_work() {
     let boxes = |x: f32| {
-        VolumeInstance::new(
+        Medium::new(
             ConstantBox::new(
                 Vec3::new(x, -0.5, -0.5),
                 Vec3::new(x + 1.0, 0.5, 0.5),
@@ -117,7 +123,7 @@ fn rays_that_miss_every_volume_do_no_work() {
     let volumes = Volumes::new(vec![boxes(-3.0), boxes(2.0), boxes(5.0)]);
     // A camera looking up, away from all three boxes.
     let camera = cirrus_render::Camera::new(Vec3::ZERO, Vec3::Y, Vec3::Z, 30.0, 8, 8);
-    let out = render_media(
+    let out = common::render_through(
         &volumes,
         &camera,
         &lights(),

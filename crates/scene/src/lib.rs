@@ -11,8 +11,9 @@
 //! - [`Scene`] holds a description and renders it: it resolves the
 //!   scene-wide [`SceneSettings`], plans each volume from its file's header,
 //!   culls the volumes no path can reach, reads only the grids that can
-//!   matter, and renders through `cirrus-render`. [`LoneVolume`] is one
-//!   volume loaded whole, which the benchmarks render many times.
+//!   matter, and renders through `cirrus-render`; [`Scene::prepare`] stops
+//!   before rendering, with the [`Prepared`] scene (the benchmarks and the
+//!   preview render it many times, a [`VolumeCache`] keeping its grids).
 //! - [`Outputs`] writes the EXR, PNG and statistics whole or not at all.
 //! - [`frames`] parses frame ranges and replaces frame patterns
 //!   (`cloud.####.vdb`) in a scene's paths ([`Scene::for_frame`]).
@@ -47,6 +48,7 @@ mod output;
 mod overrides;
 pub mod parse;
 mod plan;
+mod prepare;
 mod scene;
 mod settings;
 
@@ -57,5 +59,7 @@ pub use error::{Error, ErrorKind, Result};
 pub use flags::{OutputFlags, SceneFlags};
 pub use output::{write_whole, Outputs};
 pub use overrides::Overrides;
-pub use scene::{LoneVolume, Scene};
+pub use plan::VolumeCache;
+pub use prepare::{Placement, Prepared};
+pub use scene::Scene;
 pub use settings::SceneSettings;

@@ -1,16 +1,18 @@
 //! Loading the volumes of a scene: each volume's plan (file, grids,
-//! transform, medium, world box) and the files and grids read for it,
-//! each read once however many instances use it, with the bytes it cost.
+//! transform, medium, world box) and the [`VolumeCache`] of files and
+//! grids read for it, each read once however many instances (or renders)
+//! use it, with the bytes it cost.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use cirrus_bricks::{BrickVolume, DBounds3, VelocityGrid};
+use cirrus_bricks::{BrickVolume, DBounds3, Precision, VelocityGrid};
 use cirrus_render::medium::BrickField;
 use cirrus_render::medium::Extinction;
 use cirrus_render::{
-    Blackbody, DensityField, IntegratorKind, Phase, Shutter, Velocity, VelocityUnit, VolumeInstance,
+    Blackbody, DensityField, Emission, IntegratorKind, Medium, Phase, Shutter, Velocity,
+    VelocityUnit,
 };
 use cirrus_vdb::VolumeFile;
 use glam::{DMat3, DMat4, DVec3, Vec3};
@@ -19,13 +21,16 @@ use crate::defaults as d;
 use crate::description::{Colour, ScaleSpec, VolumeSpec};
 use crate::error::{Error, Result};
 use crate::grids::{
-    choose_grid, choose_velocity, is_cbrk, read_bricks, read_cbrk_file, read_velocity,
+    choose_grid, choose_velocity, is_cbrk, read_bricks_at, read_cbrk_file, read_render_bricks,
+    read_velocity,
 };
 
 /// One volume's plan: where its grids are and how it is placed.
 pub struct Plan {
     pub file: PathBuf,
     cbrk: bool,
+    /// How its `.vdb`/`.nvdb` grids are stored once read.
+    precision: GridPrecision,
     density: usize,
     temperature: Option<usize>,
     emission: Option<usize>,
@@ -44,9 +49,29 @@ pub struct Plan {
 }
 
 impl Plan {
+    fn grid_key(&self, index: usize) -> GridKey {
+        (self.file.clone(), index, self.precision)
+    }
+
     pub fn emits(&self) -> bool {
         self.temperature.is_some() || self.emission.is_some()
     }
+
+    /// Object to world.
+    pub fn object_to_world(&self) -> DMat4 {
+        self.object_to_world
+    }
+}
+
+/// How a grid read from a `.vdb` or `.nvdb` is stored for rendering (a
+/// `.cbrk` keeps the precision it was converted at).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GridPrecision {
+    /// 32-bit floats.
+    F32,
+    /// [`cirrus_bricks::RENDER_PRECISION`] (f16), or f32 where the
+    /// densities do not fit in f16.
+    Render,
 }
 
 fn object_to_world(v: &VolumeSpec) -> DMat4 {
@@ -76,7 +101,12 @@ fn object_to_world(v: &VolumeSpec) -> DMat4 {
 /// directory); opens its file, reading the index only. `moving`: the
 /// shutter reaches away from the frame's instant, so a velocity grid is
 /// looked for.
-pub fn plan(v: &VolumeSpec, files: &mut Files, moving: bool) -> Result<Plan> {
+pub fn plan(
+    v: &VolumeSpec,
+    files: &mut VolumeCache,
+    moving: bool,
+    precision: GridPrecision,
+) -> Result<Plan> {
     let path = v.file.clone();
     let object_to_world = object_to_world(v);
     if !object_to_world.is_finite() || object_to_world.determinant().abs() < 1e-300 {
@@ -128,6 +158,7 @@ pub fn plan(v: &VolumeSpec, files: &mut Files, moving: bool) -> Result<Plan> {
     Ok(Plan {
         file: path,
         cbrk,
+        precision,
         density,
         temperature,
         emission,
@@ -191,16 +222,20 @@ fn moved<'v>(
 }
 
 /// Open files and loaded grids, shared by the volumes that use them (two
-/// instances of one file read it once), with what reading them cost.
+/// instances of one file read it once) and kept across the renders of one
+/// cache (a preview's passes), with what reading them cost.
 #[derive(Default)]
-pub struct Files {
+pub struct VolumeCache {
     open: HashMap<PathBuf, VolumeFile>,
-    grids: HashMap<(PathBuf, usize), BrickVolume>,
+    grids: HashMap<GridKey, BrickVolume>,
     velocities: HashMap<(PathBuf, usize), Arc<VelocityGrid>>,
     cbrk_bytes: u64,
 }
 
-impl Files {
+/// A grid of a file as it is stored: file, grid index, precision.
+type GridKey = (PathBuf, usize, GridPrecision);
+
+impl VolumeCache {
     fn open(&mut self, path: &Path) -> Result<&VolumeFile> {
         if !self.open.contains_key(path) {
             let f = VolumeFile::open(path)?;
@@ -209,24 +244,34 @@ impl Files {
         Ok(&self.open[path])
     }
 
-    /// Reads grid `index` of `path` once.
-    fn grid(&mut self, path: &Path, cbrk: bool, index: usize) -> Result<&BrickVolume> {
-        let key = (path.to_path_buf(), index);
+    /// Reads grid `index` of a plan's file once.
+    fn grid(&mut self, p: &Plan, index: usize) -> Result<&BrickVolume> {
+        let key = p.grid_key(index);
         if !self.grids.contains_key(&key) {
-            let volume = if cbrk {
+            let path = &p.file;
+            let volume = if p.cbrk {
                 self.cbrk_bytes += std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
                 read_cbrk_file(path)?
             } else {
-                read_bricks(self.open(path)?, index)?
+                let f = self.open(path)?;
+                match p.precision {
+                    GridPrecision::F32 => read_bricks_at(f, index, Precision::F32)?,
+                    GridPrecision::Render => read_render_bricks(f, index)?,
+                }
             };
             self.grids.insert(key.clone(), volume);
         }
         Ok(&self.grids[&key])
     }
 
+    /// A plan's density grid, loading it.
+    pub fn density(&mut self, p: &Plan) -> Result<&BrickVolume> {
+        self.grid(p, p.density)
+    }
+
     /// The world box of a plan's density grid, loading it.
     pub fn density_box(&mut self, p: &Plan) -> Result<DBounds3> {
-        let v = self.grid(&p.file, p.cbrk, p.density)?;
+        let v = self.grid(p, p.density)?;
         let m = p.object_to_world * v.local_from_world().inverse();
         Ok(DBounds3::new(DVec3::ZERO, v.local_extent().as_dvec3()).transformed(m))
     }
@@ -273,9 +318,9 @@ impl Files {
 
     pub fn load_grids(&mut self, p: &Plan) -> Result<()> {
         self.velocity(p)?;
-        self.grid(&p.file, p.cbrk, p.density)?;
+        self.grid(p, p.density)?;
         for index in [p.temperature, p.emission].into_iter().flatten() {
-            self.grid(&p.file, p.cbrk, index)?;
+            self.grid(p, index)?;
         }
         Ok(())
     }
@@ -292,7 +337,7 @@ impl Files {
         integrator: IntegratorKind,
         refine: f32,
         shutter: Shutter,
-    ) -> Result<VolumeInstance<BrickField<'_>>> {
+    ) -> Result<Medium<BrickField<'_>>> {
         let velocity = p.velocity.map(|index| Velocity {
             grid: self.velocities[&(p.file.clone(), index)].clone(),
             unit: p.velocity_unit,
@@ -300,7 +345,7 @@ impl Files {
         });
         let moved = |f| moved(f, velocity.as_ref(), shutter, &p.file);
         let field = |index: usize| {
-            let v = &self.grids[&(p.file.clone(), index)];
+            let v = &self.grids[&p.grid_key(index)];
             BrickField::new(v, p.object_to_world, centre)
         };
         let density = field(p.density);
@@ -313,11 +358,11 @@ impl Files {
             )));
         }
         let density = moved(walk_cells(density, integrator, extinction.scale, refine))?;
-        let mut inst = VolumeInstance::new(density, extinction.scale, p.albedo, d::G)
+        let mut inst = Medium::new(density, extinction.scale, p.albedo, d::G)
             .with_phase(p.phase.clone())
             .with_extinction_tint(extinction.tint);
         if p.emits() {
-            inst.emission = Some(cirrus_render::Emission {
+            inst.emission = Some(Emission {
                 temperature: p
                     .temperature
                     .map(|i| moved(field(i)).map(|f| (f, p.blackbody)))

@@ -18,7 +18,7 @@
 //! each budget.
 
 use super::Row;
-use cirrus_render::medium::{BrickField, Medium};
+use cirrus_render::medium::Media;
 use std::fmt::Write as _;
 
 /// Nanoseconds of one render thread per tentative collision, over three
@@ -47,14 +47,14 @@ pub(super) struct CollisionCost {
 /// is divided by: on a loaded machine both slow down alike, where a
 /// one-thread timing would run faster than the render threads and make
 /// the ceiling look lower than it is.
-pub(super) fn collision_cost(medium: &Medium<BrickField>) -> CollisionCost {
-    use cirrus_render::medium::{GlobalMedia, Media};
+pub(super) fn collision_cost<M: Media>(media: &M) -> CollisionCost {
+    use cirrus_render::medium::GlobalMedia;
     use cirrus_render::stats::Counters;
     use cirrus_render::tracking::{ratio_tracking, sample_free_flight};
     use cirrus_render::{Ray, Rng};
     use rayon::prelude::*;
     const RAYS_PER_THREAD: u64 = 50_000;
-    let global = GlobalMedia::new(medium);
+    let global = GlobalMedia::new(media);
     let b = global.bounds();
     let (lo, hi) = (b.min, b.max);
     let threads = rayon::current_num_threads() as u64;
@@ -74,14 +74,16 @@ pub(super) fn collision_cost(medium: &Medium<BrickField>) -> CollisionCost {
                     let origin = lo + (hi - lo) * u;
                     let dir = cirrus_render::sampling::uniform_sphere(rng.uniform(), rng.uniform());
                     let ray = Ray::new(origin, dir);
-                    std::hint::black_box(sample_free_flight(
+                    let mut beta = glam::Vec3::ONE;
+                    std::hint::black_box(sample_free_flight::<f32, _>(
                         &global,
                         &ray,
                         f32::INFINITY,
+                        &mut beta,
                         &mut rng,
                         &mut c,
                     ));
-                    std::hint::black_box(ratio_tracking(
+                    std::hint::black_box(ratio_tracking::<f32, _>(
                         &global,
                         &ray,
                         f32::INFINITY,

@@ -157,7 +157,7 @@ impl LightGrid {
                 for i in 0..n {
                     let q = start + 0.5 * Vec3::new(i as f32, j as f32, k as f32);
                     c.density_lookups += 1;
-                    if medium.sigma_t(self.lo + self.cell * q) > 0.0 {
+                    if medium.extinction::<f32>(self.lo + self.cell * q, 0.0) > 0.0 {
                         return true;
                     }
                 }

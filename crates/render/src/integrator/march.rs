@@ -9,7 +9,7 @@
 //! skipping empty space leaves the estimate unchanged and only saves
 //! lookups (OpenVDB's `vdb_render` marches through everything).
 //!
-//! Every function is generic over [`Channels`]: `f32` for grey media (one
+//! Every function is generic over [`Spectrum`]: `f32` for grey media (one
 //! extinction, one transmittance) and `Vec3` for chromatic ones, where
 //! each step looks the three channels up at once and attenuates them
 //! apart. The grey instantiation is the scalar march itself.
@@ -22,144 +22,9 @@ use crate::medium::{Lattice, Media};
 use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::Rng;
+use crate::spectrum::Spectrum;
 use crate::stats::Counters;
-use crate::tracking::spectral::roulette_rgb;
-use crate::tracking::{roulette, ROULETTE_Q, ROULETTE_THRESHOLD};
-
-/// Extinction and transmittance of one channel (`f32`) or three (`Vec3`).
-pub(crate) trait Channels: Copy {
-    const ZERO: Self;
-    const ONE: Self;
-    /// Extinction at `p`.
-    fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self;
-    /// The channels of a medium whose extinction is `tint` times `sigma`
-    /// ([`Media::uniform_tint`]).
-    fn tinted(sigma: f32, tint: Vec3) -> Self;
-    /// Whether any channel has positive extinction (false for NaN).
-    fn any_positive(self) -> bool;
-    fn scale(self, h: f32) -> Self;
-    fn add(self, other: Self) -> Self;
-    fn mul(self, other: Self) -> Self;
-    fn one_minus(self) -> Self;
-    /// `exp(-self)` per channel.
-    fn exp_neg(self) -> Self;
-    /// The smallest channel (a march stops once every channel is opaque).
-    fn min_channel(self) -> f32;
-    /// `self` times a colour, per channel.
-    fn tint(self, v: Vec3) -> Vec3;
-    /// The channels' mean.
-    fn mean(self) -> f32;
-    fn roulette(&mut self, rng: &mut Rng) -> bool;
-}
-
-impl Channels for f32 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
-    #[inline]
-    fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self {
-        medium.sigma_t(p)
-    }
-    /// The scalar extinction itself, as [`Channels::sigma_t`] gives it
-    /// (of a chromatic medium, its largest channel: what the light grid
-    /// marches).
-    #[inline]
-    fn tinted(sigma: f32, _tint: Vec3) -> Self {
-        sigma
-    }
-    #[inline]
-    fn any_positive(self) -> bool {
-        self > 0.0
-    }
-    #[inline]
-    fn scale(self, h: f32) -> Self {
-        self * h
-    }
-    #[inline]
-    fn add(self, other: Self) -> Self {
-        self + other
-    }
-    #[inline]
-    fn mul(self, other: Self) -> Self {
-        self * other
-    }
-    #[inline]
-    fn one_minus(self) -> Self {
-        1.0 - self
-    }
-    #[inline]
-    fn exp_neg(self) -> Self {
-        (-self).exp()
-    }
-    #[inline]
-    fn min_channel(self) -> f32 {
-        self
-    }
-    #[inline]
-    fn tint(self, v: Vec3) -> Vec3 {
-        self * v
-    }
-    #[inline]
-    fn mean(self) -> f32 {
-        self
-    }
-    #[inline]
-    fn roulette(&mut self, rng: &mut Rng) -> bool {
-        roulette(self, rng)
-    }
-}
-
-impl Channels for Vec3 {
-    const ZERO: Self = Vec3::ZERO;
-    const ONE: Self = Vec3::ONE;
-    #[inline]
-    fn sigma_t<M: Media>(medium: &M, p: Vec3) -> Self {
-        medium.sigma_t_rgb_at(p, 0.0)
-    }
-    #[inline]
-    fn tinted(sigma: f32, tint: Vec3) -> Self {
-        tint * sigma
-    }
-    #[inline]
-    fn any_positive(self) -> bool {
-        self.max_element() > 0.0
-    }
-    #[inline]
-    fn scale(self, h: f32) -> Self {
-        self * h
-    }
-    #[inline]
-    fn add(self, other: Self) -> Self {
-        self + other
-    }
-    #[inline]
-    fn mul(self, other: Self) -> Self {
-        self * other
-    }
-    #[inline]
-    fn one_minus(self) -> Self {
-        Vec3::ONE - self
-    }
-    #[inline]
-    fn exp_neg(self) -> Self {
-        Vec3::new((-self.x).exp(), (-self.y).exp(), (-self.z).exp())
-    }
-    #[inline]
-    fn min_channel(self) -> f32 {
-        self.min_element()
-    }
-    #[inline]
-    fn tint(self, v: Vec3) -> Vec3 {
-        self * v
-    }
-    #[inline]
-    fn mean(self) -> f32 {
-        self.element_sum() / 3.0
-    }
-    #[inline]
-    fn roulette(&mut self, rng: &mut Rng) -> bool {
-        roulette_rgb(self, rng)
-    }
-}
+use crate::tracking::{ROULETTE_Q, ROULETTE_THRESHOLD};
 
 /// Shadow marches stop once the optical depth passes this: `exp(-30)` is
 /// below 1e-13, far under any pixel's noise.
@@ -173,7 +38,7 @@ pub const MIN_STEP_VOXELS: f32 = 1e-3;
 /// ([`Media::march_lattice`]); `visit` returns false to stop. Media whose
 /// channels share one tint look one scalar up per point; others look each
 /// channel up.
-pub(crate) fn march<M: Media, E: Channels>(
+pub(crate) fn march<M: Media, E: Spectrum>(
     medium: &M,
     ray: &Ray,
     t_max: f32,
@@ -190,7 +55,7 @@ pub(crate) fn march<M: Media, E: Channels>(
         }),
         None => lattice.visit_segments(medium.majorants(ray.origin, ray.dir, 0.0, t_max), |t| {
             c.density_lookups += 1;
-            visit(t, E::sigma_t(medium, ray.at(t)), c)
+            visit(t, medium.extinction::<E>(ray.at(t), 0.0), c)
         }),
     };
     c.dda_segments += steps;
@@ -204,7 +69,7 @@ pub(crate) enum ShadowEnd {
     /// estimate's noise would be baked in.
     Cutoff,
     /// By Russian roulette once the transmittance falls below the
-    /// trackers' threshold ([`roulette`]): unbiased with respect to the
+    /// trackers' threshold ([`Spectrum::roulette`]): unbiased with respect to the
     /// march, and a ray into a thick cloud stops after an optical depth
     /// of about 3 (with survivors re-weighted) instead of 30. For shadow
     /// rays drawn afresh at every step, whose noise averages out.
@@ -213,7 +78,7 @@ pub(crate) enum ShadowEnd {
 
 /// The jittered-march estimate of the transmittance from `p` toward `dir`
 /// (to infinity): `exp(-tau)`, ended as `end` says; counts one shadow ray.
-pub(crate) fn marched_transmittance<M: Media, E: Channels>(
+pub(crate) fn marched_transmittance<M: Media, E: Spectrum>(
     medium: &M,
     p: Vec3,
     dir: Vec3,
@@ -236,7 +101,7 @@ pub(crate) fn marched_transmittance<M: Media, E: Channels>(
         }
         ShadowEnd::Roulette => {
             // The estimate is `w exp(-tau)`. It is rouletted as the
-            // trackers' estimates are ([`roulette`]) once its largest
+            // trackers' estimates are ([`Spectrum::roulette`]) once its largest
             // channel falls below the threshold, that is once every
             // channel's optical depth passes `ln(w / threshold)`: so the
             // march sums optical depth and takes no `exp` per step.
@@ -284,7 +149,7 @@ pub(crate) fn marched_transmittance<M: Media, E: Channels>(
 /// extinction, the chosen instance's source weighted per channel by
 /// [`Interaction::weight`](crate::medium::Interaction); alpha is the
 /// channels' mean `1 - T`.
-pub(crate) fn march_camera_ray<M: Media, E: Channels>(
+pub(crate) fn march_camera_ray<M: Media, E: Spectrum>(
     medium: &M,
     lights: &Lights,
     ray: &Ray,
@@ -305,10 +170,10 @@ pub(crate) fn march_camera_ray<M: Media, E: Channels>(
         }
         let step_tr = sigma.scale(h).exp_neg();
         let p = ray.at(t);
-        let it = medium.interaction(p, rng);
+        let it = medium.interaction(p, 0.0, rng);
         let mut source = it.albedo * in_scatter(p, it.phase, rng, c);
         if emits {
-            source += (Vec3::ONE - it.albedo) * medium.emission(p, it.instance, c);
+            source += (Vec3::ONE - it.albedo) * medium.emission(p, 0.0, it.instance, c);
         }
         if chromatic {
             source *= it.weight;
@@ -329,6 +194,7 @@ pub(crate) fn march_camera_ray<M: Media, E: Channels>(
 mod tests {
     use super::*;
     use crate::medium::{GridField, Medium};
+    use crate::Volumes;
 
     /// Rouletted shadow marches keep the march's mean: from start points
     /// whose optical depth to the far side runs from about 0.5 to 6.6 (the
@@ -341,7 +207,7 @@ mod tests {
         let field = GridField::from_fn([32, 32, 32], Vec3::ZERO, 1.0, 4, |i, _, _| {
             0.25 + (i as f32 / 31.0)
         });
-        let medium = Medium::new(field, 0.3, Vec3::splat(0.9), 0.0);
+        let medium = Volumes::from(Medium::new(field, 0.3, Vec3::splat(0.9), 0.0));
         let dir = Vec3::new(1.0, 0.05, -0.02).normalize();
         let h = 1.5;
         let mut rng = Rng::new(11, 0, 0);

@@ -8,8 +8,8 @@ use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Draw, Rng, SampleStream};
+use crate::spectrum::Spectrum;
 use crate::stats::Counters;
-use crate::tracking::spectral::{sample_free_flight_spectral, transmittance_rgb};
 use crate::tracking::{sample_free_flight, transmittance, FreeFlight, TransmittanceEstimator};
 
 /// Russian roulette on path throughput starts after this many scattering
@@ -45,11 +45,12 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   1 if its first free flight collides, else 0 (for chromatic media,
 ///   else `1 - avg(beta)` with the escape weights, unbiased for the
 ///   channels' mean `1 - T`).
-/// - Chromatic media (extinction per channel) take spectral tracking for
-///   free flights and per-channel ratio tracking for shadow rays
-///   ([`crate::tracking::spectral`]); their weights go into `beta`, and
+/// - Chromatic media (extinction per channel) are traced with `Vec3` as
+///   the [`Spectrum`]: spectral tracking for free flights and per-channel
+///   ratio tracking for shadow rays; their weights go into `beta`, and
 ///   the instance weight of [`Interaction`](crate::medium::Interaction)
-///   corrects the mixture per channel. Grey media never touch that code.
+///   corrects the mixture per channel. Grey media are traced with `f32`,
+///   the scalar trackers.
 /// - Numbers: each path vertex draws its free-flight distance, light
 ///   directions, shadow rays' first optical depths, phase direction and
 ///   roulette as the [`Draw`]s of [`crate::sampling`]'s allocation
@@ -86,44 +87,10 @@ impl<'a, M: Media> PathTracer<'a, M> {
         }
     }
 
-    /// A free flight from `ray`: delta tracking, or spectral tracking
-    /// (which weights `beta`) for chromatic media.
-    #[inline]
-    fn free_flight(
-        &self,
-        ray: &Ray,
-        beta: &mut Vec3,
-        rng: &mut Rng,
-        c: &mut Counters,
-    ) -> FreeFlight {
-        if self.chromatic {
-            sample_free_flight_spectral(self.medium, ray, f32::INFINITY, beta, rng, c)
-        } else {
-            sample_free_flight(self.medium, ray, f32::INFINITY, rng, c)
-        }
-    }
-
-    /// Transmittance toward a light at infinity, per channel.
-    #[inline]
-    fn shadow(&self, ray: &Ray, rng: &mut Rng, c: &mut Counters) -> Vec3 {
-        if self.chromatic {
-            transmittance_rgb(self.estimator, self.medium, ray, f32::INFINITY, rng, c)
-        } else {
-            Vec3::splat(transmittance(
-                self.estimator,
-                self.medium,
-                ray,
-                f32::INFINITY,
-                rng,
-                c,
-            ))
-        }
-    }
-
     /// NEE at `p`, path vertex `vertex`, for a path arriving along `ray_in`
     /// (whose time the shadow rays keep).
     #[allow(clippy::too_many_arguments)]
-    fn direct_light(
+    fn direct_light<S: Spectrum>(
         &self,
         p: Vec3,
         ray_in: &Ray,
@@ -139,7 +106,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             let s = sun.sample(u1, u2);
             c.nee_rays_sun += 1;
             let shadow = (Draw::SunShadow, vertex);
-            l += self.light_term(p, ray_in, phase, s, mis, shadow, draws, c);
+            l += self.light_term::<S>(p, ray_in, phase, s, mis, shadow, draws, c);
         }
         if let Some(env) = &self.lights.environment {
             let (u1, u2) = draws.get_2d(Draw::SkyDirection, vertex);
@@ -148,7 +115,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             // A zero-density sample (a pole) is dropped without a shadow ray.
             c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
             let shadow = (Draw::SkyShadow, vertex);
-            l += self.light_term(p, ray_in, phase, s, mis, shadow, draws, c);
+            l += self.light_term::<S>(p, ray_in, phase, s, mis, shadow, draws, c);
         }
         l
     }
@@ -156,7 +123,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     /// `f * Li * T * w / p_light` for one light sample; for a delta light
     /// `radiance` is the irradiance and the pdf is a delta, so `f * E * T`.
     #[allow(clippy::too_many_arguments)]
-    fn light_term(
+    fn light_term<S: Spectrum>(
         &self,
         p: Vec3,
         ray_in: &Ray,
@@ -182,8 +149,10 @@ impl<'a, M: Media> PathTracer<'a, M> {
             Some(_) => return Vec3::ZERO,
         };
         let shadow = ray_in.spawn(p, s.to_light);
-        let tr = draws.leading(draw, vertex, |rng| self.shadow(&shadow, rng, c));
-        s.radiance * (weight * tr)
+        let tr = draws.leading(draw, vertex, |rng| {
+            transmittance::<S, M>(self.estimator, self.medium, &shadow, f32::INFINITY, rng, c)
+        });
+        s.radiance * (weight * tr.rgb())
     }
 }
 
@@ -196,6 +165,22 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
     }
 
     fn sample_stream(&self, camera_ray: Ray, draws: &mut SampleStream, c: &mut Counters) -> Sample {
+        if self.chromatic {
+            self.trace::<Vec3>(camera_ray, draws, c)
+        } else {
+            self.trace::<f32>(camera_ray, draws, c)
+        }
+    }
+}
+
+impl<M: Media> PathTracer<'_, M> {
+    /// One camera path, tracked per channel of `S`.
+    fn trace<S: Spectrum>(
+        &self,
+        camera_ray: Ray,
+        draws: &mut SampleStream,
+        c: &mut Counters,
+    ) -> Sample {
         c.paths += 1;
         let emits = self.medium.emits();
         let mut ray = camera_ray;
@@ -214,12 +199,11 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             // vertex `vertex` of the draw allocation.
             let vertex = depth;
             let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
-                self.free_flight(&ray, &mut beta, rng, c)
+                sample_free_flight::<S, M>(self.medium, &ray, f32::INFINITY, &mut beta, rng, c)
             });
             if depth == 0 {
                 alpha = match flight {
-                    FreeFlight::Escaped if self.chromatic => 1.0 - beta.element_sum() / 3.0,
-                    FreeFlight::Escaped => 0.0,
+                    FreeFlight::Escaped => S::escaped_alpha(beta),
                     _ => 1.0,
                 };
             }
@@ -237,8 +221,8 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 FreeFlight::Collision { t } => t,
             };
             let p = ray.at(t);
-            let it = self.medium.interaction_at(p, ray.time, draws.rng());
-            if self.chromatic {
+            let it = self.medium.interaction(p, ray.time, draws.rng());
+            if S::CHROMATIC {
                 beta *= it.weight;
             }
             if depth == 0 {
@@ -248,7 +232,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             if emits {
                 let e = beta
                     * (Vec3::ONE - it.albedo)
-                    * self.medium.emission_at(p, ray.time, it.instance, c);
+                    * self.medium.emission(p, ray.time, it.instance, c);
                 l += e;
                 aov.emission += e;
             }
@@ -261,7 +245,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 break;
             }
             let last = self.max_depth == Some(depth);
-            let direct = beta * self.direct_light(p, &ray, it.phase, !last, vertex, draws, c);
+            let direct = beta * self.direct_light::<S>(p, &ray, it.phase, !last, vertex, draws, c);
             l += direct;
             if depth == 1 {
                 aov.direct += direct;

@@ -3,13 +3,14 @@
 
 use glam::Vec3;
 
-use super::march::{march_camera_ray, marched_transmittance, Channels, ShadowEnd};
+use super::march::{march_camera_ray, marched_transmittance, ShadowEnd};
 use super::{CameraSampler, Sample};
 use crate::light::Lights;
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::Rng;
+use crate::spectrum::Spectrum;
 use crate::stats::Counters;
 
 /// Fixed-step single-scattering ray marcher with marched shadow rays.
@@ -55,7 +56,7 @@ impl<'a, M: Media> RayMarcher<'a, M> {
     }
 
     /// Phase-weighted light arriving at `p` for a ray travelling along `dir`.
-    fn in_scatter<E: Channels>(
+    fn in_scatter<E: Spectrum>(
         &self,
         p: Vec3,
         dir: Vec3,
@@ -108,7 +109,7 @@ impl<M: Media> CameraSampler for RayMarcher<'_, M> {
 }
 
 impl<M: Media> RayMarcher<'_, M> {
-    fn march<E: Channels>(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
+    fn march<E: Spectrum>(&self, ray: Ray, rng: &mut Rng, c: &mut Counters) -> Sample {
         march_camera_ray::<M, E>(
             self.medium,
             &self.lights,

@@ -1,5 +1,5 @@
 //! [`Media`]: what the trackers and integrators need from whatever fills
-//! the scene, one [`Medium`] or several overlapping volume instances
+//! the scene, one [`Medium`](super::Medium) or several overlapping ones
 //! ([`Volumes`](crate::volumes::Volumes)).
 //!
 //! Extinction is the sum over the media present at a point, so the
@@ -7,7 +7,7 @@
 //! extinction units (1 / render-space length). For chromatic media that
 //! scalar is each instance's largest channel, summed: it bounds every
 //! channel's extinction, so the same majorants serve all three, and
-//! [`Media::sigma_t_rgb`] gives the channels themselves. What differs between
+//! [`Media::extinction`] gives the channels themselves as a `Vec3`. What differs between
 //! instances, albedo, phase function and emission, is asked for only at a
 //! real collision: [`Media::interaction`] picks the instance that scattered
 //! with probability `sigma_t,i / sigma_t`, which makes the mixture's
@@ -17,10 +17,10 @@
 
 use glam::Vec3;
 
-use super::field::{Bounds3, DensityField, Lattice, MajorantSegment};
-use super::Medium;
+use super::field::{Bounds3, Lattice, MajorantSegment};
 use crate::phase::Phase;
 use crate::sampling::Rng;
+use crate::spectrum::Spectrum;
 use crate::stats::Counters;
 
 /// What scatters (or emits) at a real collision.
@@ -42,7 +42,9 @@ pub struct Interaction<'a> {
     pub weight: Vec3,
 }
 
-/// The participating media of a scene, in render space.
+/// The participating media of a scene, in render space: what the trackers
+/// and integrators need, and nothing else. Every method is required, so a
+/// wrapper ([`GlobalMedia`]) cannot silently miss one.
 pub trait Media: Send + Sync {
     type Majorants<'a>: Iterator<Item = MajorantSegment>
     where
@@ -53,56 +55,35 @@ pub trait Media: Send + Sync {
     /// extinction units.
     fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_>;
 
-    /// Total extinction coefficient at `p` (of chromatic media: the sum of
-    /// each instance's largest channel, a bound of every channel).
-    fn sigma_t(&self, p: Vec3) -> f32;
+    /// Total extinction at `p` at shutter time `time` (the trackers look it
+    /// up at a ray's time; media without motion are the same at every
+    /// time): per channel for `Vec3`, and for `f32` the sum of each
+    /// instance's largest channel, a bound of every channel
+    /// ([`Spectrum::tinted`]).
+    fn extinction<S: Spectrum>(&self, p: Vec3, time: f32) -> S;
+
+    /// Whether extinction differs between colour channels anywhere; when
+    /// false every channel's extinction is the scalar one and the
+    /// integrators track `f32`.
+    fn chromatic(&self) -> bool;
+
+    /// `Some(tint)` when every channel's extinction is `tint` times the
+    /// scalar extinction everywhere (grey media: 1), so a march can look
+    /// up one scalar; `None` for mixtures of differently tinted media.
+    fn uniform_tint(&self) -> Option<Vec3>;
 
     /// Calls `visit(t, sigma_t)` at the points of `lattice` along the ray
-    /// within `[0, t_max]` where the extinction may be non-zero (see
+    /// within `[0, t_max]` where the scalar extinction may be non-zero (see
     /// [`DensityField::march_lattice`]), until `visit` returns false;
-    /// returns the walk's steps. The default walks the majorant segments.
+    /// returns the walk's steps.
     fn march_lattice(
         &self,
         origin: Vec3,
         dir: Vec3,
         t_max: f32,
         lattice: Lattice,
-        mut visit: impl FnMut(f32, f32) -> bool,
-    ) -> u64 {
-        lattice.visit_segments(self.majorants(origin, dir, 0.0, t_max), |t| {
-            visit(t, self.sigma_t(origin + dir * t))
-        })
-    }
-
-    /// `Some(tint)` when every channel's extinction is `tint` times
-    /// [`sigma_t`](Self::sigma_t) everywhere (grey media: 1), so a march
-    /// can look up one scalar; `None` for mixtures of differently tinted
-    /// media.
-    fn uniform_tint(&self) -> Option<Vec3> {
-        (!self.chromatic()).then_some(Vec3::ONE)
-    }
-
-    /// Total extinction at `p` at shutter time `time` (what the trackers
-    /// look up: a ray's time). Media without motion are the same at every
-    /// time, which is the default.
-    #[inline]
-    fn sigma_t_at(&self, p: Vec3, _time: f32) -> f32 {
-        self.sigma_t(p)
-    }
-
-    /// Whether extinction differs between colour channels anywhere; when
-    /// false every channel's extinction is [`Media::sigma_t`] and the
-    /// integrators take their scalar paths.
-    fn chromatic(&self) -> bool {
-        false
-    }
-
-    /// Extinction per RGB channel at `p` at shutter time `time`, each at
-    /// most [`Media::sigma_t_at`].
-    #[inline]
-    fn sigma_t_rgb_at(&self, p: Vec3, time: f32) -> Vec3 {
-        Vec3::splat(self.sigma_t_at(p, time))
-    }
+        visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64;
 
     /// Render-space bounds of where extinction may be non-zero.
     fn bounds(&self) -> Bounds3;
@@ -110,40 +91,25 @@ pub trait Media: Send + Sync {
     /// Smallest voxel size (ray-march steps are given in voxels).
     fn voxel_size(&self) -> f32;
 
-    /// An upper bound of `sigma_t` everywhere (the global-majorant mode).
+    /// An upper bound of the scalar extinction everywhere (the
+    /// global-majorant mode).
     fn max_sigma_t(&self) -> f32;
 
-    /// The instance that a real collision at `p` belongs to, chosen with
-    /// probability `sigma_t,i(p) / sigma_t(p)`. Draws from `rng` only when
-    /// several instances overlap at `p`, so a lone medium's random streams
-    /// are those of the single-medium renderer.
-    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_>;
-
-    /// [`interaction`](Self::interaction) with the instances' extinctions
-    /// taken at shutter time `time`.
-    #[inline]
-    fn interaction_at(&self, p: Vec3, _time: f32, rng: &mut Rng) -> Interaction<'_> {
-        self.interaction(p, rng)
-    }
+    /// The instance that a real collision at `p` at shutter time `time`
+    /// belongs to, chosen with probability `sigma_t,i(p) / sigma_t(p)`.
+    /// Draws from `rng` only when several instances overlap at `p`, so a
+    /// lone medium's random streams are those of a single-medium renderer.
+    fn interaction(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_>;
 
     /// Whether any instance emits; when false the integrators do no
     /// emission work at all.
-    fn emits(&self) -> bool {
-        false
-    }
+    fn emits(&self) -> bool;
 
-    /// Emitted radiance `Le` of `instance` at `p` (the source term of the
-    /// radiative transfer equation is `sigma_a * Le`); counts its lookups.
-    fn emission(&self, _p: Vec3, _instance: u32, _c: &mut Counters) -> Vec3 {
-        Vec3::ZERO
-    }
-
-    /// [`emission`](Self::emission) at shutter time `time` (emission
-    /// grids move with the density).
-    #[inline]
-    fn emission_at(&self, p: Vec3, _time: f32, instance: u32, c: &mut Counters) -> Vec3 {
-        self.emission(p, instance, c)
-    }
+    /// Emitted radiance `Le` of `instance` at `p` at shutter time `time`
+    /// (the source term of the radiative transfer equation is
+    /// `sigma_a * Le`; emission grids move with the density); counts its
+    /// lookups.
+    fn emission(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3;
 }
 
 /// A field's segments multiplied by a density scale.
@@ -169,80 +135,6 @@ impl<I: Iterator<Item = MajorantSegment>> Iterator for Scaled<I> {
 impl<I> Scaled<I> {
     pub fn new(inner: I, scale: f32) -> Self {
         Self { inner, scale }
-    }
-}
-
-/// A lone medium: one field, one material, no emission.
-impl<F: DensityField> Media for Medium<F> {
-    type Majorants<'a>
-        = Scaled<F::Segments<'a>>
-    where
-        Self: 'a;
-
-    #[inline]
-    fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_> {
-        Scaled::new(
-            self.field.segments(origin, dir, t_min, t_max),
-            self.density_scale,
-        )
-    }
-
-    #[inline]
-    fn sigma_t(&self, p: Vec3) -> f32 {
-        self.density_scale * self.field.density(p)
-    }
-
-    #[inline]
-    fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
-        self.density_scale * self.field.density_at(p, time)
-    }
-
-    fn march_lattice(
-        &self,
-        origin: Vec3,
-        dir: Vec3,
-        t_max: f32,
-        lattice: Lattice,
-        mut visit: impl FnMut(f32, f32) -> bool,
-    ) -> u64 {
-        let scale = self.density_scale;
-        self.field
-            .march_lattice(origin, dir, t_max, lattice, |t, d| visit(t, scale * d))
-    }
-
-    fn uniform_tint(&self) -> Option<Vec3> {
-        Some(self.extinction_tint)
-    }
-
-    fn chromatic(&self) -> bool {
-        self.extinction_tint != Vec3::ONE
-    }
-
-    #[inline]
-    fn sigma_t_rgb_at(&self, p: Vec3, time: f32) -> Vec3 {
-        self.extinction_tint * self.sigma_t_at(p, time)
-    }
-
-    fn bounds(&self) -> Bounds3 {
-        self.field.bounds()
-    }
-
-    fn voxel_size(&self) -> f32 {
-        self.field.voxel_size()
-    }
-
-    fn max_sigma_t(&self) -> f32 {
-        self.density_scale * self.field.global_majorant()
-    }
-
-    #[inline]
-    fn interaction(&self, _p: Vec3, _rng: &mut Rng) -> Interaction<'_> {
-        Interaction {
-            albedo: self.albedo,
-            phase: &self.phase,
-            instance: 0,
-            weight: Vec3::ONE,
-        }
     }
 }
 
@@ -281,17 +173,28 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
         .into_iter()
     }
 
-    fn sigma_t(&self, p: Vec3) -> f32 {
-        self.inner.sigma_t(p)
-    }
-    fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
-        self.inner.sigma_t_at(p, time)
+    fn extinction<S: Spectrum>(&self, p: Vec3, time: f32) -> S {
+        self.inner.extinction(p, time)
     }
     fn chromatic(&self) -> bool {
         self.inner.chromatic()
     }
-    fn sigma_t_rgb_at(&self, p: Vec3, time: f32) -> Vec3 {
-        self.inner.sigma_t_rgb_at(p, time)
+    fn uniform_tint(&self) -> Option<Vec3> {
+        self.inner.uniform_tint()
+    }
+    /// The global bound's one segment, walked: there are no occupied cells
+    /// to skip by.
+    fn march_lattice(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        mut visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        lattice.visit_segments(self.majorants(origin, dir, 0.0, t_max), |t| {
+            visit(t, self.extinction(origin + dir * t, 0.0))
+        })
     }
     fn bounds(&self) -> Bounds3 {
         self.inner.bounds()
@@ -302,19 +205,62 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
     fn max_sigma_t(&self) -> f32 {
         self.majorant
     }
-    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
-        self.inner.interaction(p, rng)
-    }
-    fn interaction_at(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
-        self.inner.interaction_at(p, time, rng)
+    fn interaction(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
+        self.inner.interaction(p, time, rng)
     }
     fn emits(&self) -> bool {
         self.inner.emits()
     }
-    fn emission(&self, p: Vec3, instance: u32, c: &mut Counters) -> Vec3 {
-        self.inner.emission(p, instance, c)
+    fn emission(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
+        self.inner.emission(p, time, instance, c)
     }
-    fn emission_at(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
-        self.inner.emission_at(p, time, instance, c)
+}
+
+/// Borrowed media are media, so a [`Scene`](crate::Scene) can borrow them.
+impl<M: Media> Media for &M {
+    type Majorants<'a>
+        = M::Majorants<'a>
+    where
+        Self: 'a;
+
+    fn majorants(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self::Majorants<'_> {
+        (**self).majorants(origin, dir, t_min, t_max)
+    }
+    fn extinction<S: Spectrum>(&self, p: Vec3, time: f32) -> S {
+        (**self).extinction(p, time)
+    }
+    fn chromatic(&self) -> bool {
+        (**self).chromatic()
+    }
+    fn uniform_tint(&self) -> Option<Vec3> {
+        (**self).uniform_tint()
+    }
+    fn march_lattice(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        (**self).march_lattice(origin, dir, t_max, lattice, visit)
+    }
+    fn bounds(&self) -> Bounds3 {
+        (**self).bounds()
+    }
+    fn voxel_size(&self) -> f32 {
+        (**self).voxel_size()
+    }
+    fn max_sigma_t(&self) -> f32 {
+        (**self).max_sigma_t()
+    }
+    fn interaction(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
+        (**self).interaction(p, time, rng)
+    }
+    fn emits(&self) -> bool {
+        (**self).emits()
+    }
+    fn emission(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
+        (**self).emission(p, time, instance, c)
     }
 }

@@ -7,13 +7,16 @@
 //!   volumes of `cirrus-bricks`, placed in render space.
 //! - `global` is the one segment of a global majorant (Mitsuba-style),
 //!   which [`GlobalMedia`] puts over any media.
-//! - `media` defines [`Media`], what the trackers and integrators walk: a
-//!   lone [`Medium`] or several volume instances, in extinction units.
+//! - `media` defines [`Media`], what the trackers and integrators walk, in
+//!   extinction units ([`Volumes`](crate::Volumes) is the one
+//!   implementation a scene renders; [`GlobalMedia`] wraps any).
+//! - `emission` is what a medium emits: blackbody or an emission grid.
 //! - `motion` moves a brick field with a velocity grid (motion blur).
 
 mod brick_field;
 #[cfg(feature = "testing")]
 mod constant_box;
+mod emission;
 mod field;
 mod global;
 #[cfg(feature = "testing")]
@@ -26,6 +29,7 @@ mod motion;
 pub use brick_field::BrickField;
 #[cfg(feature = "testing")]
 pub use constant_box::ConstantBox;
+pub use emission::Emission;
 pub use field::{Bounds3, DensityField, Lattice, MajorantSegment};
 #[cfg(feature = "testing")]
 pub use grid_field::GridField;
@@ -38,18 +42,21 @@ use glam::Vec3;
 
 use crate::phase::Phase;
 
-/// A participating medium: extinction
+/// A participating medium: a density field placed in render space and what
+/// turns it into light transport. Extinction is
 /// `sigma_t,c(p) = extinction_tint_c * density_scale * density(p)` per RGB
-/// channel `c`, `sigma_s = albedo * sigma_t` per channel, and a phase
-/// function.
+/// channel `c`, `sigma_s = albedo * sigma_t` per channel, scattering follows
+/// the phase function, and an optional [`Emission`] adds the source term.
 ///
 /// `density_scale` is the largest channel's extinction per unit density,
 /// so the field's majorants scaled by it bound every channel; the tint is
 /// each channel's share of it, in [0, 1]. A grey medium (tint 1, 1, 1)
 /// samples free flights and transmittance as scalars; a coloured albedo
-/// then only tints the path throughput. A chromatic one takes the spectral
-/// trackers ([`crate::tracking::spectral`]).
-#[derive(Clone, Debug)]
+/// then only tints the path throughput. A chromatic one is tracked per
+/// channel ([`crate::spectrum`]).
+///
+/// What the renderer walks is [`Media`]: one medium or several overlapping
+/// ones are [`Volumes`](crate::Volumes) (`Volumes::from(medium)`).
 pub struct Medium<F> {
     pub field: F,
     /// Converts field density to the largest channel's extinction, in
@@ -60,6 +67,7 @@ pub struct Medium<F> {
     /// Single-scattering albedo `sigma_s / sigma_t` per RGB channel, in [0, 1].
     pub albedo: Vec3,
     pub phase: Phase,
+    pub emission: Option<Emission<F>>,
 }
 
 impl<F: DensityField> Medium<F> {
@@ -72,6 +80,7 @@ impl<F: DensityField> Medium<F> {
             extinction_tint: Vec3::ONE,
             albedo,
             phase: Phase::hg(g),
+            emission: None,
         }
     }
 
@@ -88,11 +97,40 @@ impl<F: DensityField> Medium<F> {
         }
     }
 
-    /// Extinction coefficient at `p` (the largest channel's).
-    #[inline]
-    pub fn sigma_t(&self, p: Vec3) -> f32 {
-        self.density_scale * self.field.density(p)
+    pub fn with_emission(self, emission: Emission<F>) -> Self {
+        Self {
+            emission: Some(emission),
+            ..self
+        }
     }
+
+    /// Extinction coefficient at `p` at shutter time `time` (the largest
+    /// channel's).
+    #[inline]
+    pub fn sigma_t(&self, p: Vec3, time: f32) -> f32 {
+        self.density_scale * self.field.density_at(p, time)
+    }
+
+    /// Checks the medium's parameters.
+    pub fn validate(&self) -> Result<(), MediumError> {
+        if !(self.density_scale.is_finite() && self.density_scale >= 0.0) {
+            return Err(MediumError::DensityScale(self.density_scale));
+        }
+        let a = self.albedo;
+        if !a.is_finite() || a.min_element() < 0.0 || a.max_element() > 1.0 {
+            return Err(MediumError::Albedo(a));
+        }
+        Ok(())
+    }
+}
+
+/// A medium parameter out of range.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MediumError {
+    #[error("density scale must be finite and >= 0, got {0}")]
+    DensityScale(f32),
+    #[error("albedo must lie in [0, 1], got {0}")]
+    Albedo(Vec3),
 }
 
 /// Extinction per unit density and RGB channel, split into what the

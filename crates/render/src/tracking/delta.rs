@@ -1,12 +1,14 @@
 //! Delta (Woodcock) tracking: unbiased free-flight sampling against local
-//! majorants.
+//! majorants, and its chromatic form, spectral tracking.
+
+use glam::Vec3;
 
 use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
+use crate::spectrum::{Collision, Spectrum};
 use crate::stats::Counters;
 
-use super::lookup;
 use super::walk::{Event, Walk};
 
 /// Where a free flight ended.
@@ -18,25 +20,26 @@ pub enum FreeFlight {
     Escaped,
     /// A real collision at ray parameter `t`.
     Collision { t: f32 },
-    /// The collision cap was hit; callers end the path.
+    /// The collision cap was hit, or the path's weight died; callers end
+    /// the path.
     Capped,
 }
 
 /// Samples the distance to the first real collision along `ray` within
 /// `[0, t_max]` with density `sigma_t(t) exp(-integral of sigma_t)`.
 ///
-/// Tentative collisions come from the majorant walk; one at `t` is real
-/// with probability `sigma_t(t) / sigma_maj` (Woodcock et al. 1965; pbrt-v4
-/// `SampleT_maj` with its absorption and scattering events merged, since the
-/// path integrator weights by albedo). When `xi * sigma_maj` falls below
-/// the segment's minorant the collision is real whatever the density, so it
-/// is accepted without a lookup: the same decision with the same random
-/// number, only cheaper (the control part of decomposition tracking, Kutz
-/// et al. 2017).
-pub fn sample_free_flight<M: Media>(
+/// Tentative collisions come from the majorant walk; each is decided by
+/// [`Spectrum::collide`]: delta tracking for a grey medium (`beta`
+/// untouched), spectral tracking for a chromatic one, which multiplies
+/// `beta` by the flight's weights. On escape `beta` then carries the
+/// null-collision weights, whose expectation is each channel's
+/// transmittance; at a collision it also carries `sigma_t / (sigma_maj
+/// P_r)`, so that multiplying by the albedo gives the scattering term.
+pub fn sample_free_flight<S: Spectrum, M: Media>(
     medium: &M,
     ray: &Ray,
     t_max: f32,
+    beta: &mut Vec3,
     rng: &mut Rng,
     c: &mut Counters,
 ) -> FreeFlight {
@@ -48,12 +51,14 @@ pub fn sample_free_flight<M: Media>(
             Event::End => return FreeFlight::Escaped,
             Event::Capped => return FreeFlight::Capped,
             Event::Collision { t, segment, .. } => {
-                let xi = rng.uniform() * segment.majorant;
-                if xi < segment.minorant || xi < lookup(medium, ray, t, segment.majorant, c) {
-                    c.real_collisions += 1;
-                    return FreeFlight::Collision { t };
+                match S::collide(medium, ray, t, &segment, beta, rng, c) {
+                    Collision::Real => {
+                        c.real_collisions += 1;
+                        return FreeFlight::Collision { t };
+                    }
+                    Collision::Null => c.null_collisions += 1,
+                    Collision::Dead => return FreeFlight::Capped,
                 }
-                c.null_collisions += 1;
             }
         }
     }

@@ -1,17 +1,19 @@
 //! Null-collision trackers over a field's majorant segments: free-flight
 //! sampling (`delta`) and three transmittance estimators (`ratio`,
-//! `residual`, `track_length`), all built on the walk in `walk`; and their
-//! per-channel counterparts for chromatic media in [`spectral`].
+//! `residual`, `track_length`), all built on the walk in `walk`. Each is
+//! written once over a [`Spectrum`]: `f32` for grey media, `Vec3` for
+//! chromatic ones (extinction per RGB channel), where free flights take
+//! spectral tracking and shadow rays per-channel ratio tracking.
 //!
 //! Every tracker caps its collisions per call at [`MAX_COLLISIONS`]
 //! (counted in `Counters::collision_cap_hits`; a capped call returns zero
 //! transmittance / ends the path), so an infinite or NaN majorant cannot hang
-//! a render. The ratio estimators use pbrt-v4's Russian roulette.
+//! a render. The ratio estimators use pbrt-v4's Russian roulette
+//! ([`Spectrum::roulette`]).
 
 mod delta;
 mod ratio;
 mod residual;
-pub mod spectral;
 mod track_length;
 mod walk;
 
@@ -25,6 +27,7 @@ use serde::{Deserialize, Serialize};
 use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
+use crate::spectrum::Spectrum;
 use crate::stats::Counters;
 
 /// Hard cap on tentative collisions in one tracker call.
@@ -47,7 +50,9 @@ pub enum TransmittanceEstimator {
     /// Ratio tracking (Novak, Selle, Jarosz 2014).
     Ratio,
     /// Residual ratio tracking with the segment minorant as control
-    /// (Novak et al. 2014, section 5).
+    /// (Novak et al. 2014, section 5). Chromatic media take ratio tracking
+    /// instead: the segments' one minorant (of the largest channel summed
+    /// over instances) is no control for each channel.
     #[default]
     Residual,
     /// Track-length estimation: 1 if a delta-tracked flight escapes, else 0.
@@ -64,60 +69,25 @@ impl TransmittanceEstimator {
     }
 }
 
-/// Transmittance along `ray` over `[0, t_max]` by the chosen estimator;
-/// counts one shadow ray.
-pub fn transmittance<M: Media>(
+/// Transmittance along `ray` over `[0, t_max]` by the chosen estimator,
+/// per channel of `S`; counts one shadow ray.
+pub fn transmittance<S: Spectrum, M: Media>(
     estimator: TransmittanceEstimator,
     medium: &M,
     ray: &Ray,
     t_max: f32,
     rng: &mut Rng,
     c: &mut Counters,
-) -> f32 {
+) -> S {
     match estimator {
-        TransmittanceEstimator::Ratio => ratio_tracking(medium, ray, t_max, rng, c),
-        TransmittanceEstimator::Residual => residual_ratio_tracking(medium, ray, t_max, rng, c),
+        TransmittanceEstimator::Residual if !S::CHROMATIC => {
+            S::splat(residual_ratio_tracking(medium, ray, t_max, rng, c))
+        }
+        TransmittanceEstimator::Ratio | TransmittanceEstimator::Residual => {
+            ratio_tracking(medium, ray, t_max, rng, c)
+        }
         TransmittanceEstimator::TrackLength => {
             track_length_transmittance(medium, ray, t_max, rng, c)
         }
     }
-}
-
-/// Unbiased Russian roulette on a transmittance estimate (pbrt-v4): below
-/// [`ROULETTE_THRESHOLD`] it becomes 0 with probability [`ROULETTE_Q`] and is
-/// divided by `1 - q` otherwise, so its expectation is unchanged. Returns
-/// false when the estimate is (now) zero and the walk can stop.
-#[inline]
-pub(crate) fn roulette(tr: &mut f32, rng: &mut Rng) -> bool {
-    if *tr <= 0.0 {
-        *tr = 0.0;
-        return false;
-    }
-    if *tr < ROULETTE_THRESHOLD {
-        if rng.uniform() < ROULETTE_Q {
-            *tr = 0.0;
-            return false;
-        }
-        *tr /= 1.0 - ROULETTE_Q;
-    }
-    true
-}
-
-/// Density lookup at a tentative collision, at the ray's time, counted,
-/// with majorant violations (density above the segment's bound) counted too.
-#[inline]
-pub(crate) fn lookup<M: Media>(
-    medium: &M,
-    ray: &Ray,
-    t: f32,
-    sigma_maj: f32,
-    c: &mut Counters,
-) -> f32 {
-    c.density_lookups += 1;
-    let sigma = medium.sigma_t_at(ray.at(t), ray.time);
-    // A relative slack of 1e-5 forgives the f32 rounding of interpolation.
-    if sigma > sigma_maj * (1.0 + 1e-5) {
-        c.majorant_violations += 1;
-    }
-    sigma
 }

@@ -3,10 +3,10 @@
 use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
+use crate::spectrum::{lookup, Spectrum};
 use crate::stats::Counters;
 
 use super::walk::{Event, Walk};
-use super::{lookup, roulette};
 
 /// Transmittance along `ray` over `[0, t_max]` by residual ratio tracking
 /// (Novak, Selle, Jarosz 2014, section 5, eq. 12) with each segment's
@@ -17,7 +17,8 @@ use super::{lookup, roulette};
 /// the control part in closed form per segment, and tentative collisions
 /// drawn at the residual rate `sigma_maj - sigma_c`. Where the segment is
 /// constant (`sigma_maj == sigma_c`) the residual rate is 0: no collisions,
-/// and the segment's transmittance is exact.
+/// and the segment's transmittance is exact. Grey media only: the
+/// segments' minorant bounds the largest channel, no control for each.
 pub fn residual_ratio_tracking<M: Media>(
     medium: &M,
     ray: &Ray,
@@ -36,16 +37,16 @@ pub fn residual_ratio_tracking<M: Media>(
             Event::Enter(segment) => {
                 if segment.minorant > 0.0 {
                     tr *= (-segment.minorant * (segment.t1 - segment.t0)).exp();
-                    if !roulette(&mut tr, rng) {
+                    if !tr.roulette(rng) {
                         return 0.0;
                     }
                 }
             }
             Event::Collision { t, segment, rate } => {
                 c.shadow_collisions += 1;
-                let sigma = lookup(medium, ray, t, segment.majorant, c);
+                let sigma: f32 = lookup(medium, ray, t, segment.majorant, c);
                 tr *= (1.0 - (sigma - segment.minorant) / rate).max(0.0);
-                if !roulette(&mut tr, rng) {
+                if !tr.roulette(rng) {
                     return 0.0;
                 }
             }

@@ -1,10 +1,9 @@
-//! Several volume instances in one scene: [`Volumes`], the [`Media`] the
-//! scene files render.
+//! The volumes of a scene: [`Volumes`], the [`Media`] every render walks.
 //!
-//! Each [`VolumeInstance`] is a density field already placed in render
+//! Each instance is a [`Medium`]: a density field already placed in render
 //! space (its object-to-world transform folded into the field, as
 //! [`BrickField`](crate::medium::BrickField) does), a density scale, an
-//! albedo, a phase function, and optional [`Emission`].
+//! albedo, a phase function, and optional emission.
 //!
 //! - `bvh`: the top-level BVH (obvhs) that finds the instances a ray meets.
 //! - `merge`: where instances overlap, extinction and the majorant (and
@@ -22,94 +21,14 @@ pub use merge::Merged;
 
 use glam::Vec3;
 
-use crate::blackbody::Blackbody;
-use crate::medium::{Bounds3, DensityField, Interaction, MajorantSegment, Media, Scaled};
-use crate::phase::Phase;
+use crate::medium::{
+    Bounds3, DensityField, Interaction, Lattice, MajorantSegment, Media, Medium, Scaled,
+};
 use crate::sampling::Rng;
+use crate::spectrum::Spectrum;
 use crate::stats::Counters;
 
-/// What an instance emits: blackbody radiation from a temperature grid,
-/// and/or a scalar emission grid times a colour. Each grid is its own
-/// field with its own bounds, so lookups happen only where it lives.
-pub struct Emission<F> {
-    pub temperature: Option<(F, Blackbody)>,
-    /// The grid and the colour its values multiply (scale included).
-    pub grid: Option<(F, Vec3)>,
-}
-
-impl<F: DensityField> Emission<F> {
-    /// Emitted radiance `Le` at `p`.
-    #[inline]
-    pub fn radiance(&self, p: Vec3, c: &mut Counters) -> Vec3 {
-        self.radiance_at(p, 0.0, c)
-    }
-
-    /// Emitted radiance `Le` at `p` at shutter time `time`: the grids move
-    /// with their own velocity (set on each field), as the density does.
-    #[inline]
-    pub fn radiance_at(&self, p: Vec3, time: f32, c: &mut Counters) -> Vec3 {
-        let inside = |f: &F| f.bounds().contains(p);
-        let mut le = Vec3::ZERO;
-        if let Some((field, bb)) = &self.temperature {
-            if inside(field) {
-                c.emission_lookups += 1;
-                le += bb.radiance(field.density_at(p, time));
-            }
-        }
-        if let Some((field, colour)) = &self.grid {
-            if inside(field) {
-                c.emission_lookups += 1;
-                le += *colour * field.density_at(p, time).max(0.0);
-            }
-        }
-        le
-    }
-}
-
-/// One volume of a scene.
-pub struct VolumeInstance<F> {
-    pub density: F,
-    /// The largest channel's extinction per unit density, in
-    /// 1 / render-space units.
-    pub density_scale: f32,
-    /// Each channel's extinction relative to `density_scale`, in [0, 1]
-    /// ([`Medium`](crate::Medium) states the convention).
-    pub extinction_tint: Vec3,
-    pub albedo: Vec3,
-    pub phase: Phase,
-    pub emission: Option<Emission<F>>,
-}
-
-impl<F: DensityField> VolumeInstance<F> {
-    /// An instance with the Henyey-Greenstein phase function of asymmetry
-    /// `g` ([`Phase::hg`]); [`VolumeInstance::with_phase`] sets any other.
-    pub fn new(density: F, density_scale: f32, albedo: Vec3, g: f32) -> Self {
-        Self {
-            density,
-            density_scale,
-            extinction_tint: Vec3::ONE,
-            albedo,
-            phase: Phase::hg(g),
-            emission: None,
-        }
-    }
-
-    pub fn with_phase(self, phase: Phase) -> Self {
-        Self { phase, ..self }
-    }
-
-    pub fn with_extinction_tint(self, extinction_tint: Vec3) -> Self {
-        Self {
-            extinction_tint,
-            ..self
-        }
-    }
-
-    #[inline]
-    fn sigma_t(&self, p: Vec3, time: f32) -> f32 {
-        self.density_scale * self.density.density_at(p, time)
-    }
-
+impl<F: DensityField> Medium<F> {
     fn interaction(&self, instance: usize, weight: Vec3) -> Interaction<'_> {
         Interaction {
             albedo: self.albedo,
@@ -120,9 +39,9 @@ impl<F: DensityField> VolumeInstance<F> {
     }
 }
 
-/// The instances of a scene with their top-level BVH.
+/// The media of a scene with their top-level BVH.
 pub struct Volumes<F> {
-    instances: Vec<VolumeInstance<F>>,
+    instances: Vec<Medium<F>>,
     top: TopLevel,
     bounds: Bounds3,
     voxel_size: f32,
@@ -132,17 +51,17 @@ pub struct Volumes<F> {
 }
 
 impl<F: DensityField> Volumes<F> {
-    pub fn new(instances: Vec<VolumeInstance<F>>) -> Self {
-        let boxes: Vec<Bounds3> = instances.iter().map(|i| i.density.bounds()).collect();
+    pub fn new(instances: Vec<Medium<F>>) -> Self {
+        let boxes: Vec<Bounds3> = instances.iter().map(|i| i.field.bounds()).collect();
         let bounds = boxes.iter().fold(Bounds3::EMPTY, |u, &b| u.union(b));
         let voxel_size = instances
             .iter()
-            .map(|i| i.density.voxel_size())
+            .map(|i| i.field.voxel_size())
             .fold(f32::INFINITY, f32::min);
         // Overlaps add, so the sum bounds sigma_t everywhere.
         let max_sigma_t = instances
             .iter()
-            .map(|i| i.density_scale * i.density.global_majorant())
+            .map(|i| i.density_scale * i.field.global_majorant())
             .sum();
         let emits = instances.iter().any(|i| i.emission.is_some());
         let chromatic = instances.iter().any(|i| i.extinction_tint != Vec3::ONE);
@@ -157,8 +76,13 @@ impl<F: DensityField> Volumes<F> {
         }
     }
 
-    pub fn instances(&self) -> &[VolumeInstance<F>] {
+    pub fn instances(&self) -> &[Medium<F>] {
         &self.instances
+    }
+
+    /// The instances, given back (to wrap their fields, say).
+    pub fn into_instances(self) -> Vec<Medium<F>> {
+        self.instances
     }
 
     /// The instances the ray meets within `[t_min, t_max]`, by entry.
@@ -169,7 +93,7 @@ impl<F: DensityField> Volumes<F> {
     fn instance_segments(&self, hit: &Hit, origin: Vec3, dir: Vec3) -> Scaled<F::Segments<'_>> {
         let inst = &self.instances[hit.instance as usize];
         Scaled::new(
-            inst.density.segments(origin, dir, hit.t0, hit.t1),
+            inst.field.segments(origin, dir, hit.t0, hit.t1),
             inst.density_scale,
         )
     }
@@ -208,7 +132,7 @@ impl<F: DensityField> Media for Volumes<F> {
             1 => {
                 let inst = &self.instances[0];
                 VolumeSegments::One(Scaled::new(
-                    inst.density.segments(origin, dir, t_min, t_max),
+                    inst.field.segments(origin, dir, t_min, t_max),
                     inst.density_scale,
                 ))
             }
@@ -225,19 +149,19 @@ impl<F: DensityField> Media for Volumes<F> {
         }
     }
 
+    /// One instance: its own extinction (the fast path); several: the sum
+    /// over the instances containing `p`, in BVH order.
     #[inline]
-    fn sigma_t(&self, p: Vec3) -> f32 {
-        self.sigma_t_at(p, 0.0)
-    }
-
-    #[inline]
-    fn sigma_t_at(&self, p: Vec3, time: f32) -> f32 {
+    fn extinction<S: Spectrum>(&self, p: Vec3, time: f32) -> S {
         if self.instances.len() == 1 {
-            return self.instances[0].sigma_t(p, time);
+            let inst = &self.instances[0];
+            return S::tinted(inst.sigma_t(p, time), inst.extinction_tint);
         }
-        let mut sigma = 0.0;
-        self.top
-            .containing(p, |i| sigma += self.instances[i].sigma_t(p, time));
+        let mut sigma = S::ZERO;
+        self.top.containing(p, |i| {
+            let inst = &self.instances[i];
+            sigma = sigma.add(S::tinted(inst.sigma_t(p, time), inst.extinction_tint));
+        });
         sigma
     }
 
@@ -245,18 +169,35 @@ impl<F: DensityField> Media for Volumes<F> {
         self.chromatic
     }
 
-    #[inline]
-    fn sigma_t_rgb_at(&self, p: Vec3, time: f32) -> Vec3 {
+    /// One instance: its tint. Several: 1 when all are grey, else `None`
+    /// (each channel is looked up).
+    fn uniform_tint(&self) -> Option<Vec3> {
+        match self.instances.as_slice() {
+            [one] => Some(one.extinction_tint),
+            _ => (!self.chromatic).then_some(Vec3::ONE),
+        }
+    }
+
+    /// One instance: its field's own march (which may skip empty cells
+    /// faster than its segments); several: the merged segments walked.
+    fn march_lattice(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lattice: Lattice,
+        mut visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
         if self.instances.len() == 1 {
             let inst = &self.instances[0];
-            return inst.extinction_tint * inst.sigma_t(p, time);
+            let scale = inst.density_scale;
+            return inst
+                .field
+                .march_lattice(origin, dir, t_max, lattice, |t, d| visit(t, scale * d));
         }
-        let mut sigma = Vec3::ZERO;
-        self.top.containing(p, |i| {
-            let inst = &self.instances[i];
-            sigma += inst.extinction_tint * inst.sigma_t(p, time);
-        });
-        sigma
+        lattice.visit_segments(self.majorants(origin, dir, 0.0, t_max), |t| {
+            visit(t, self.extinction(origin + dir * t, 0.0))
+        })
     }
 
     fn bounds(&self) -> Bounds3 {
@@ -276,13 +217,7 @@ impl<F: DensityField> Media for Volumes<F> {
     /// (largest channels, for chromatic media, with the per-channel
     /// correction in [`Interaction::weight`]); a random number is drawn
     /// only when two or more have density there.
-    fn interaction(&self, p: Vec3, rng: &mut Rng) -> Interaction<'_> {
-        self.interaction_at(p, 0.0, rng)
-    }
-
-    /// As [`interaction`](Media::interaction), with each instance's
-    /// extinction at shutter time `time`.
-    fn interaction_at(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
+    fn interaction(&self, p: Vec3, time: f32, rng: &mut Rng) -> Interaction<'_> {
         if self.instances.len() == 1 {
             return self.instances[0].interaction(0, Vec3::ONE);
         }
@@ -340,16 +275,17 @@ impl<F: DensityField> Media for Volumes<F> {
         self.emits
     }
 
-    #[inline]
-    fn emission(&self, p: Vec3, instance: u32, c: &mut Counters) -> Vec3 {
-        self.emission_at(p, 0.0, instance, c)
-    }
-
-    #[inline]
-    fn emission_at(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
+    fn emission(&self, p: Vec3, time: f32, instance: u32, c: &mut Counters) -> Vec3 {
         match &self.instances[instance as usize].emission {
-            Some(e) => e.radiance_at(p, time, c),
+            Some(e) => e.radiance(p, time, c),
             None => Vec3::ZERO,
         }
+    }
+}
+
+/// One medium alone.
+impl<F: DensityField> From<Medium<F>> for Volumes<F> {
+    fn from(medium: Medium<F>) -> Self {
+        Volumes::new(vec![medium])
     }
 }

@@ -3,8 +3,8 @@
 
 use cirrus_render::Bounds3;
 use cirrus_render::{
-    Budget, Camera, Environment, GridField, Image, IntegratorKind, Lights, Medium, RenderSettings,
-    Scene, Sun,
+    render, Budget, Camera, Environment, GridField, Image, IntegratorKind, Lights, Media, Medium,
+    RenderSettings, Rendered, Scene, Sun, Volumes,
 };
 use glam::Vec3;
 
@@ -50,7 +50,8 @@ pub fn sun(angular_diameter_degrees: f32) -> Option<Sun> {
     ))
 }
 
-pub fn scene<F>(medium: Medium<F>, size: u32, lights: Lights) -> Scene<F>
+/// `medium` alone, framed, under `lights`.
+pub fn scene<F>(medium: Medium<F>, size: u32, lights: Lights) -> Scene<Volumes<F>>
 where
     F: cirrus_render::DensityField,
 {
@@ -61,10 +62,25 @@ where
     let blob = Vec3::new(0.3, 0.22, 0.3);
     let camera = Camera::framing(Bounds3::new(centre - blob, centre + blob), size, size);
     Scene {
-        medium,
+        media: Volumes::from(medium),
         camera,
         lights,
     }
+}
+
+/// Renders `media` (borrowed) through `camera` under `lights`.
+pub fn render_through<M: Media>(
+    media: &M,
+    camera: &Camera,
+    lights: &Lights,
+    settings: &RenderSettings,
+) -> Rendered {
+    let scene = Scene {
+        media,
+        camera: *camera,
+        lights: lights.clone(),
+    };
+    render(&scene, settings)
 }
 
 pub fn settings(integrator: IntegratorKind, spp: u32, seed: u64) -> RenderSettings {

@@ -1,0 +1,218 @@
+//! A scene description on its way to the renderer: planned, placed in
+//! render space, culled and loaded ([`Prepared`]), the one road every
+//! render takes, whether the scene came from a scene file, a lone volume
+//! file, a Python dict or a preview's view.
+
+use std::time::Instant;
+
+use cirrus_bricks::{Bounds3, DBounds3};
+use cirrus_render::medium::BrickField;
+use cirrus_render::{Camera, Crop, DensityField, RenderSettings, Rendered, Volumes};
+use glam::DVec3;
+
+use crate::cull::{in_frustum, needed};
+use crate::description::SceneDescription;
+use crate::error::{Error, Result};
+use crate::plan::{plan, GridPrecision, Plan, VolumeCache};
+use crate::settings::SceneSettings;
+
+/// Where render space and the default camera come from.
+///
+/// Render space is world space minus a centre chosen in f64, so that f32
+/// stays precise for volumes far from the origin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Placement {
+    /// Centred on the union of the volumes' world boxes (from their
+    /// headers where the files give them, so culling reads no voxel), the
+    /// default camera framing that union; `.vdb`/`.nvdb` grids kept in
+    /// f32. Scene files.
+    Volumes,
+    /// Centred on the one volume's brick grid and framed by it; its grid
+    /// kept at render precision ([`GridPrecision::Render`]). A lone volume
+    /// file.
+    OwnGrid,
+}
+
+impl Placement {
+    fn precision(self) -> GridPrecision {
+        match self {
+            Placement::Volumes => GridPrecision::F32,
+            Placement::OwnGrid => GridPrecision::Render,
+        }
+    }
+}
+
+/// What the renderer takes, with what it cost to load.
+pub struct Prepared<'c> {
+    pub scene: cirrus_render::Scene<Volumes<BrickField<'c>>>,
+    pub settings: RenderSettings,
+    /// The world position of render space's origin.
+    pub centre: DVec3,
+    /// Volumes neither the camera nor any light path can reach (not loaded).
+    pub culled: u64,
+    pub bytes_read: u64,
+    pub grids_loaded: u64,
+    /// Wall time spent planning, reading and converting.
+    pub load_seconds: f64,
+}
+
+impl Prepared<'_> {
+    /// Renders, with the load figures in the statistics.
+    pub fn render(&self) -> Rendered {
+        let mut rendered = cirrus_render::render(&self.scene, &self.settings);
+        let s = &mut rendered.stats;
+        s.bytes_read = self.bytes_read;
+        s.grids_loaded = self.grids_loaded;
+        s.volumes_culled = self.culled;
+        s.load_seconds = self.load_seconds;
+        rendered
+    }
+}
+
+/// Plans, places, culls and loads `desc` (resolved as `settings`) through
+/// `cache`.
+pub fn prepare<'c>(
+    desc: &SceneDescription,
+    settings: SceneSettings,
+    placement: Placement,
+    cache: &'c mut VolumeCache,
+) -> Result<Prepared<'c>> {
+    let start = Instant::now();
+    let shutter = settings.render.shutter;
+    let moving = shutter.max_abs_time() > 0.0;
+    let plans = desc
+        .volumes
+        .iter()
+        .map(|v| plan(v, cache, moving, placement.precision()))
+        .collect::<Result<Vec<_>>>()?;
+    let boxes: Vec<DBounds3> = plans
+        .iter()
+        .map(|p| match p.world_box {
+            Some(b) => Ok(b),
+            None => cache.density_box(p),
+        })
+        .collect::<Result<_>>()?;
+    let (centre, framed) = match (placement, plans.as_slice()) {
+        (Placement::OwnGrid, [one]) => own_grid(cache, one)?,
+        _ => {
+            let union = boxes.iter().fold(DBounds3::EMPTY, |u, &b| u.union(b));
+            let centre = union.centre();
+            (centre, union.relative_to(centre))
+        }
+    };
+    let camera = camera(&settings, centre, framed);
+    // Culling sees where the density can move to over the shutter; the
+    // framing and render space above stay those of the still frame.
+    let boxes: Vec<DBounds3> = plans
+        .iter()
+        .zip(boxes)
+        .map(|(p, b)| cache.motion_box(p, b, shutter))
+        .collect::<Result<_>>()?;
+    let keep = reachable(&settings, &camera, &plans, &boxes, centre);
+
+    // Read what is needed, then place it.
+    let kept = || plans.iter().zip(&keep).filter(|(_, k)| **k).map(|(p, _)| p);
+    for p in kept() {
+        cache.load_grids(p)?;
+    }
+    let cache: &'c VolumeCache = cache;
+    let r = &settings.render;
+    let instances = kept()
+        .map(|p| {
+            cache.instance(
+                p,
+                centre,
+                r.integrator,
+                settings.refine_optical_depth,
+                shutter,
+            )
+        })
+        .collect::<Result<Vec<_>>>()?;
+    if instances.is_empty() {
+        return Err(Error::input(
+            "no volume is visible and none can light one: nothing to render",
+        ));
+    }
+    let volumes = Volumes::new(instances);
+    integrator_supports(&volumes, r)?;
+    Ok(Prepared {
+        scene: cirrus_render::Scene {
+            media: volumes,
+            camera,
+            lights: settings.lights,
+        },
+        settings: settings.render,
+        centre,
+        culled: keep.iter().filter(|k| !**k).count() as u64,
+        bytes_read: cache.bytes_read(),
+        grids_loaded: cache.grids_loaded(),
+        load_seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// [`Placement::OwnGrid`]'s centre, the middle of the volume's brick grid
+/// (object to world applied), and the grid's render-space box.
+fn own_grid(cache: &mut VolumeCache, p: &Plan) -> Result<(DVec3, Bounds3)> {
+    let volume = cache.density(p)?;
+    let world_from_local = p.object_to_world() * volume.local_from_world().inverse();
+    let centre = world_from_local.transform_point3(volume.local_extent().as_dvec3() * 0.5);
+    let framed = BrickField::new(volume, p.object_to_world(), centre).bounds();
+    Ok((centre, framed))
+}
+
+/// Which volumes can matter: in the camera's frustum (of the crop window)
+/// or reachable by light paths from one that is (`cull.rs`).
+fn reachable(
+    settings: &SceneSettings,
+    camera: &Camera,
+    plans: &[Plan],
+    boxes: &[DBounds3],
+    centre: DVec3,
+) -> Vec<bool> {
+    let (w, h) = settings.res;
+    let window = settings.render.crop.unwrap_or(Crop {
+        x0: 0,
+        y0: 0,
+        x1: w,
+        y1: h,
+    });
+    let visible: Vec<bool> = boxes
+        .iter()
+        .map(|b| in_frustum(camera, window, b.relative_to(centre)))
+        .collect();
+    let any_emission = plans.iter().any(|p| p.emits());
+    needed(
+        &visible,
+        boxes,
+        &settings.lights,
+        any_emission,
+        settings.render.max_depth,
+    )
+}
+
+/// The camera of `s` in render space (world minus `centre`), framing
+/// `framed` (render space) when no eye and target are given.
+fn camera(s: &SceneSettings, centre: DVec3, framed: Bounds3) -> Camera {
+    let to_render = |p: DVec3| (p - centre).as_vec3();
+    let (w, h) = s.res;
+    match s.look_at {
+        Some((from, to)) => Camera::new(to_render(from), to_render(to), s.camera_up, s.fov, w, h),
+        None => Camera::framing(framed, w, h),
+    }
+}
+
+/// Whether the chosen integrator can render `media`: the two-pass marcher
+/// caches one transmittance per light, so it cannot attenuate channels
+/// apart.
+fn integrator_supports<M: cirrus_render::Media>(
+    media: &M,
+    settings: &RenderSettings,
+) -> Result<()> {
+    if media.chromatic() && settings.integrator == cirrus_render::IntegratorKind::RayMarch2Pass {
+        return Err(Error::input(
+            "raymarch2pass caches one transmittance per light and cannot render a chromatic \
+             medium (a density scale per channel); use --integrator path or raymarch",
+        ));
+    }
+    Ok(())
+}
