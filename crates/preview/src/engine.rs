@@ -168,8 +168,8 @@ impl Engine {
         let r = match result {
             Ok(_) | Err(_) if p.control.is_cancelled() => return,
             Ok(r) => r,
-            Err(e) if e.kind == ErrorKind::Cancelled => return,
-            Err(e) => return self.fail(shared, p.key, e.message),
+            Err(e) if e.kind() == ErrorKind::Cancelled => return,
+            Err(e) => return self.fail(shared, p.key, e.to_string()),
         };
         let rate = r.stats.counters.paths as f64 / seconds.max(1e-9);
         let old = self.rates.entry(integrator(&p.key)).or_insert(rate);

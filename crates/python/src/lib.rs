@@ -25,10 +25,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
 fn py_err(e: Error) -> PyErr {
-    match e.kind {
-        ErrorKind::File => PyOSError::new_err(e.message),
-        ErrorKind::Input => PyValueError::new_err(e.message),
-        ErrorKind::Cancelled => PyKeyboardInterrupt::new_err(e.message),
+    let message = e.to_string();
+    match e.kind() {
+        ErrorKind::File => PyOSError::new_err(message),
+        ErrorKind::Input => PyValueError::new_err(message),
+        ErrorKind::Cancelled => PyKeyboardInterrupt::new_err(message),
     }
 }
 

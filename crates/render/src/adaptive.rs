@@ -21,6 +21,7 @@
 //! threshold falls (they are of order `1/n` relative to the mean); see the
 //! pooled test in `tests/adaptive.rs` for a measured bound.
 
+use crate::error::{Error, Result};
 use crate::film::{Film, PixelAccumulator};
 
 /// Below this mean intensity (in the image's radiance units) the error is
@@ -39,18 +40,18 @@ pub struct Adaptive {
 }
 
 impl Adaptive {
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         if !(self.threshold.is_finite() && self.threshold > 0.0) {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "noise threshold must be a positive relative error, got {}",
                 self.threshold
-            ));
+            )));
         }
         if self.min_spp < 2 {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "min spp must be at least 2 (a variance needs two samples), got {}",
                 self.min_spp
-            ));
+            )));
         }
         Ok(())
     }

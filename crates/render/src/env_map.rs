@@ -21,6 +21,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use crate::distribution::Distribution2D;
+use crate::error::{exr_error, Result};
 
 /// An equirectangular environment map with its sampling distribution.
 #[derive(Clone, Debug)]
@@ -76,7 +77,7 @@ impl EnvMap {
     }
 
     /// Reads the first RGB(A) layer of an OpenEXR file (alpha ignored).
-    pub fn read_exr(path: &Path, rotation_degrees: f32) -> Result<Self, String> {
+    pub fn read_exr(path: &Path, rotation_degrees: f32) -> Result<Self> {
         use exr::prelude::*;
         let image = read_first_rgba_layer_from_file(
             path,
@@ -87,11 +88,11 @@ impl EnvMap {
                 px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
             },
         )
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+        .map_err(|e| exr_error(path, e))?;
         let (w, px) = image.layer_data.channel_data.pixels;
         let h = px.len() / w.max(1);
         if w == 0 || h == 0 {
-            return Err(format!("{}: empty image", path.display()));
+            return Err(crate::error::Error::format(path, "empty image"));
         }
         Ok(Self::new(w, h, px, rotation_degrees))
     }

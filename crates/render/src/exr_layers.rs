@@ -15,6 +15,7 @@
 
 use std::path::Path;
 
+use crate::error::{exr_error, Error, Result};
 use crate::film::AovImage;
 use crate::render::Rendered;
 
@@ -49,12 +50,14 @@ impl Aov {
         }
     }
 
-    pub fn parse(s: &str) -> Result<Aov, String> {
+    pub fn parse(s: &str) -> Result<Aov> {
         Aov::ALL
             .into_iter()
             .find(|a| a.name() == s.trim())
             .ok_or_else(|| {
-                format!("unknown AOV {s:?} (known: albedo, depth, emission, direct, samples)")
+                Error::invalid(format!(
+                    "unknown AOV {s:?} (known: albedo, depth, emission, direct, samples)"
+                ))
             })
     }
 
@@ -154,9 +157,9 @@ struct Tile {
     channels: Vec<(String, Vec<f32>)>,
 }
 
-fn read_tile(path: &Path) -> Result<Tile, String> {
+fn read_tile(path: &Path) -> Result<Tile> {
     use exr::prelude::*;
-    let err = |e: exr::error::Error| format!("{}: {e}", path.display());
+    let err = |e| exr_error(path, e);
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -167,9 +170,9 @@ fn read_tile(path: &Path) -> Result<Tile, String> {
         .map_err(err)?;
     let dw = image.attributes.display_window;
     if dw.position != Vec2(0, 0) {
-        return Err(format!(
-            "{}: display window must start at 0,0",
-            path.display()
+        return Err(crate::error::Error::format(
+            path,
+            "display window must start at 0,0",
         ));
     }
     let layer = image.layer_data;
@@ -200,8 +203,10 @@ fn read_tile(path: &Path) -> Result<Tile, String> {
 /// Assembles crop tiles into one full-size EXR. The tiles must share the
 /// display window and channel names, lie inside the image, not overlap,
 /// and cover it exactly; any violation is an error naming the file.
-pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<(), String> {
-    let first = tiles.first().ok_or("no tiles to merge")?;
+pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
+    let first = tiles
+        .first()
+        .ok_or_else(|| Error::invalid("no tiles to merge"))?;
     let t0 = read_tile(first)?;
     let (fw, fh) = t0.full;
     let names: Vec<String> = t0.channels.iter().map(|(n, _)| n.clone()).collect();
@@ -216,32 +221,32 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<(), String> {
         } else {
             read_tile(path)?
         };
-        let here = path.display();
+        let misfit = |message: String| Error::format(path, message);
         if t.full != (fw, fh) {
-            return Err(format!(
-                "{here}: image is {}x{}, the first tile's is {fw}x{fh}",
+            return Err(misfit(format!(
+                "image is {}x{}, the first tile's is {fw}x{fh}",
                 t.full.0, t.full.1
-            ));
+            )));
         }
         let tile_names: Vec<&String> = t.channels.iter().map(|(n, _)| n).collect();
         if tile_names != names.iter().collect::<Vec<_>>() {
-            return Err(format!("{here}: channels differ from the first tile's"));
+            return Err(misfit("channels differ from the first tile's".into()));
         }
         let (x0, y0) = t.position;
         let (w, h) = t.size;
         if x0 < 0 || y0 < 0 || x0 as usize + w > fw || y0 as usize + h > fh {
-            return Err(format!("{here}: data window lies outside the image"));
+            return Err(misfit("data window lies outside the image".into()));
         }
         let (x0, y0) = (x0 as usize, y0 as usize);
         for y in 0..h {
             for x in 0..w {
                 let i = (y0 + y) * fw + x0 + x;
                 if covered[i] {
-                    return Err(format!(
-                        "{here}: pixel ({}, {}) is in two tiles",
+                    return Err(misfit(format!(
+                        "pixel ({}, {}) is in two tiles",
                         x0 + x,
                         y0 + y
-                    ));
+                    )));
                 }
                 covered[i] = true;
             }
@@ -254,11 +259,11 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<(), String> {
         }
     }
     if let Some(i) = covered.iter().position(|c| !c) {
-        return Err(format!(
+        return Err(Error::invalid(format!(
             "the tiles leave pixel ({}, {}) uncovered",
             i % fw,
             i / fw
-        ));
+        )));
     }
     write_channels(
         out,
@@ -267,12 +272,12 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<(), String> {
         (fw, fh),
         names.into_iter().zip(data).collect(),
     )
-    .map_err(|e| format!("{}: {e}", out.display()))
+    .map_err(|e| Error::io(out, e))
 }
 
 /// Every channel of an EXR's first layer over its data window, by name,
 /// with the window's position and size (for tests and tools).
-pub fn read_channels(path: &Path) -> Result<ExrChannels, String> {
+pub fn read_channels(path: &Path) -> Result<ExrChannels> {
     let t = read_tile(path)?;
     Ok(ExrChannels {
         full: t.full,

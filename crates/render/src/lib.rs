@@ -46,6 +46,7 @@ pub mod camera;
 pub mod control;
 pub mod distribution;
 pub mod env_map;
+pub mod error;
 pub mod exr_layers;
 pub mod film;
 pub mod image_io;
@@ -70,6 +71,7 @@ pub use blackbody::Blackbody;
 pub use camera::Camera;
 pub use control::RenderControl;
 pub use env_map::EnvMap;
+pub use error::{Error, Result};
 pub use film::{AovImage, Image};
 pub use integrator::{
     AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, PathTracer, RayMarcher,

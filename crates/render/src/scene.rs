@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::adaptive::Adaptive;
 use crate::camera::Camera;
 use crate::control::RenderControl;
+use crate::error::{Error, Result};
 use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::light::Lights;
 use crate::sampling::SamplerKind;
@@ -117,12 +118,12 @@ pub struct Crop {
 
 impl Crop {
     /// Checks the window is non-empty and inside a `width x height` image.
-    pub fn validate(&self, width: u32, height: u32) -> Result<(), String> {
+    pub fn validate(&self, width: u32, height: u32) -> Result<()> {
         if self.x0 >= self.x1 || self.y0 >= self.y1 || self.x1 > width || self.y1 > height {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "crop {},{},{},{} must be a non-empty window x0 < x1 <= {width}, y0 < y1 <= {height}",
                 self.x0, self.y0, self.x1, self.y1
-            ));
+            )));
         }
         Ok(())
     }
@@ -159,13 +160,13 @@ impl RenderSettings {
         self.shadow_step_voxels.unwrap_or(self.step_voxels)
     }
 
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         match self.budget {
-            Budget::Spp(0) => return Err("spp must be at least 1".into()),
+            Budget::Spp(0) => return Err(Error::invalid("spp must be at least 1")),
             Budget::Time(s) if !(s.is_finite() && s > 0.0) => {
-                return Err(format!(
+                return Err(Error::invalid(format!(
                     "time budget must be a positive number of seconds, got {s}"
-                ))
+                )))
             }
             _ => {}
         }
@@ -173,23 +174,25 @@ impl RenderSettings {
             .shadow_step_voxels
             .filter(|s| !(s.is_finite() && *s > 0.0))
         {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "shadow step must be a positive number of voxels, got {s}"
-            ));
+            )));
         }
         self.shutter.validate()?;
         if !(self.step_voxels.is_finite() && self.step_voxels > 0.0) {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "step must be a positive number of voxels, got {}",
                 self.step_voxels
-            ));
+            )));
         }
         let g = &self.light_grid;
         if !(g.cell_voxels.is_finite() && g.cell_voxels > 0.0) || g.env_directions == 0 {
-            return Err("light grid needs a positive cell size and at least one direction".into());
+            return Err(Error::invalid(
+                "light grid needs a positive cell size and at least one direction",
+            ));
         }
         if self.tile_size == 0 {
-            return Err("tile size must be at least 1".into());
+            return Err(Error::invalid("tile size must be at least 1"));
         }
         if let Some(a) = &self.adaptive {
             a.validate()?;

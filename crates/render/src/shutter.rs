@@ -1,6 +1,7 @@
 //! The camera shutter: the interval of time, in frames relative to the
 //! frame rendered, over which each pixel integrates (motion blur).
 
+use crate::error::{Error, Result};
 use crate::sampling::SampleStream;
 
 /// A shutter open over `[open, close]` frames around the frame's own
@@ -27,12 +28,12 @@ impl Shutter {
     }
 
     /// Checks the interval is finite and not reversed.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         if !(self.open.is_finite() && self.close.is_finite()) || self.close < self.open {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "shutter {},{} must be finite with open <= close (frames)",
                 self.open, self.close
-            ));
+            )));
         }
         Ok(())
     }

@@ -197,13 +197,14 @@ pub fn phase_of(v: &VolumeSpec) -> Result<Phase> {
         "mie" => Phase::mie(v.droplet_diameter.unwrap_or(d::DROPLET_DIAMETER)),
         "rayleigh" => Ok(Phase::rayleigh()),
         _ => match name.strip_prefix("table:") {
-            Some(path) => return Phase::read_table(path).map_err(Error::file),
-            None => Err(format!(
+            // The table's own errors name its file.
+            Some(path) => return Ok(Phase::read_table(path)?),
+            None => Err(cirrus_render::Error::invalid(format!(
                 "phase {name:?}: expected hg, hg2, draine, mie, rayleigh or table:FILE"
-            )),
+            ))),
         },
     };
-    phase.map_err(|e| Error::input(format!("{}: {e}", v.file.display())))
+    phase.map_err(|e| Error::from(e).within(v.file.display()))
 }
 
 /// `field` moving with `velocity` over `shutter`, if it has one.

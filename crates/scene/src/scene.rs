@@ -39,10 +39,7 @@ impl Scene {
     pub fn load(path: &Path) -> Result<Scene> {
         if path.extension().is_some_and(|e| e == "toml") {
             let description = SceneDescription::read(path)?;
-            Scene::from_description(description, parent(path)).map_err(|e| Error {
-                message: format!("{}: {}", path.display(), e.message),
-                ..e
-            })
+            Scene::from_description(description, parent(path)).map_err(|e| e.within(path.display()))
         } else {
             Ok(Scene::volume(path))
         }

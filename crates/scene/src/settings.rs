@@ -96,8 +96,7 @@ fn lights(desc: &SceneDescription) -> Result<Lights> {
     let environment = match &env.map {
         None => Environment::new(Vec3::from_array(env.radiance.unwrap_or(d::SKY_RADIANCE))),
         Some(path) => {
-            let map = EnvMap::read_exr(path, env.rotation.unwrap_or(d::SKY_ROTATION))
-                .map_err(Error::file)?;
+            let map = EnvMap::read_exr(path, env.rotation.unwrap_or(d::SKY_ROTATION))?;
             Environment::from_map(
                 Arc::new(map),
                 Vec3::splat(env.intensity.unwrap_or(d::SKY_INTENSITY)),

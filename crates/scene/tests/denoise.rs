@@ -36,7 +36,7 @@ fn mse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
 fn denoising_16_spp_cuts_the_error_at_least_5x() {
     let denoised = match render(16, 1, true) {
         Ok(image) => image,
-        Err(e) if e.kind == ErrorKind::File && std::env::var_os("CIRRUS_OIDN").is_none() => {
+        Err(e) if e.kind() == ErrorKind::File && std::env::var_os("CIRRUS_OIDN").is_none() => {
             eprintln!("SKIPPED: no Open Image Denoise library ({e}); set CIRRUS_OIDN to run");
             return;
         }

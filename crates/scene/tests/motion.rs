@@ -76,11 +76,11 @@ fn a_velocity_grid_that_is_not_vec3_is_an_error_naming_file_and_grid() {
     .err()
     .expect("a float grid is no velocity");
     assert!(
-        e.message.contains("multi_grid.vdb") && e.message.contains("\"temperature\""),
+        e.to_string().contains("multi_grid.vdb") && e.to_string().contains("\"temperature\""),
         "{}",
-        e.message
+        e
     );
-    assert!(e.message.contains("vec3"), "{}", e.message);
+    assert!(e.to_string().contains("vec3"), "{e}");
 }
 
 #[test]

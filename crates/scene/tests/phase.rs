@@ -41,9 +41,9 @@ fn bad_phases_are_input_errors_naming_what_is_wrong() {
         ..Default::default()
     })
     .unwrap_err();
-    assert_eq!(e.kind, ErrorKind::Input);
+    assert_eq!(e.kind(), ErrorKind::Input);
     assert!(
-        e.message.contains("mei") && e.message.contains("rayleigh"),
+        e.to_string().contains("mei") && e.to_string().contains("rayleigh"),
         "{e}"
     );
     let e = render(Overrides {
@@ -52,14 +52,14 @@ fn bad_phases_are_input_errors_naming_what_is_wrong() {
         ..Default::default()
     })
     .unwrap_err();
-    assert_eq!(e.kind, ErrorKind::Input, "{e}");
+    assert_eq!(e.kind(), ErrorKind::Input, "{e}");
     let e = render(Overrides {
         phase: Some("table:/no/such/table.txt".into()),
         ..Default::default()
     })
     .unwrap_err();
-    assert_eq!(e.kind, ErrorKind::File);
-    assert!(e.message.contains("/no/such/table.txt"), "{e}");
+    assert_eq!(e.kind(), ErrorKind::File);
+    assert!(e.to_string().contains("/no/such/table.txt"), "{e}");
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! A convex combination of two lobes.
 
 use super::Lobe;
+use crate::error::{Error, Result};
 
 /// Largest f32 below 1: a rescaled uniform number stays in `[0, 1)`.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
@@ -21,9 +22,11 @@ pub struct Blend<A, B> {
 
 impl<A: Lobe, B: Lobe> Blend<A, B> {
     /// Errors unless `w`, the weight of `a`, is in `[0, 1]` (NaN included).
-    pub fn new(a: A, b: B, w: f32) -> Result<Self, String> {
+    pub fn new(a: A, b: B, w: f32) -> Result<Self> {
         if !(0.0..=1.0).contains(&w) {
-            return Err(format!("lobe weight must be in [0, 1], got {w}"));
+            return Err(Error::invalid(format!(
+                "lobe weight must be in [0, 1], got {w}"
+            )));
         }
         Ok(Self { a, b, w })
     }

@@ -2,6 +2,7 @@
 
 use super::hg::HenyeyGreenstein;
 use super::Lobe;
+use crate::error::{Error, Result};
 
 /// An `alpha` below this is taken as 0 (pure HG), in `eval` and `sample`
 /// alike: it changes the function by less than 1e-6 relative, and the
@@ -26,12 +27,14 @@ pub struct Draine {
 impl Draine {
     /// `g` is clamped like [`HenyeyGreenstein::new`]'s. Errors: a
     /// non-finite `g`, a negative or non-finite `alpha`.
-    pub fn new(g: f32, alpha: f32) -> Result<Self, String> {
+    pub fn new(g: f32, alpha: f32) -> Result<Self> {
         if !g.is_finite() {
-            return Err(format!("Draine g must be finite, got {g}"));
+            return Err(Error::invalid(format!("Draine g must be finite, got {g}")));
         }
         if !(alpha.is_finite() && alpha >= 0.0) {
-            return Err(format!("Draine alpha must be finite and >= 0, got {alpha}"));
+            return Err(Error::invalid(format!(
+                "Draine alpha must be finite and >= 0, got {alpha}"
+            )));
         }
         let hg = HenyeyGreenstein::new(g);
         let alpha = if alpha < MIN_ALPHA { 0.0 } else { alpha };

@@ -3,6 +3,7 @@
 use super::blend::Blend;
 use super::draine::Draine;
 use super::hg::HenyeyGreenstein;
+use crate::error::{Error, Result};
 
 /// The droplet diameters, in micrometres, that the fit below covers. The
 /// paper fits smaller droplets with other formulas (its eqs. 11-22), which
@@ -37,13 +38,13 @@ pub struct MieFit {
 impl MieFit {
     /// Errors for a non-finite diameter or one outside
     /// [`MIE_DIAMETER_RANGE_UM`].
-    pub fn new(diameter_um: f32) -> Result<Self, String> {
+    pub fn new(diameter_um: f32) -> Result<Self> {
         let (lo, hi) = MIE_DIAMETER_RANGE_UM;
         if !(lo..=hi).contains(&diameter_um) {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "droplet diameter must be in [{lo}, {hi}] um (the range of the \
                  Jendersie-d'Eon fit), got {diameter_um}"
-            ));
+            )));
         }
         let d = f64::from(diameter_um);
         Ok(Self {
@@ -60,7 +61,7 @@ impl MieFit {
     /// `g_D` in [0.5, 0.63], `alpha` in [17, 33] and `w_D` in [0.45, 0.51],
     /// so the lobe constructors accept them unchanged (the errors cannot
     /// occur for a `MieFit` from [`MieFit::new`]).
-    pub fn blend(&self) -> Result<Blend<HenyeyGreenstein, Draine>, String> {
+    pub fn blend(&self) -> Result<Blend<HenyeyGreenstein, Draine>> {
         let hg = HenyeyGreenstein::new(self.g_hg);
         let draine = Draine::new(self.g_d, self.alpha)?;
         Blend::new(hg, draine, 1.0 - self.w_d)

@@ -43,6 +43,7 @@ pub use mie::{MieFit, MIE_DIAMETER_RANGE_UM};
 pub use rayleigh::Rayleigh;
 pub use table::{TabulatedPhase, MAX_TABLE_ROWS};
 
+use crate::error::{Error, Result};
 use crate::sampling::from_local;
 
 /// A rotationally symmetric phase function: a density of `mu` per
@@ -98,12 +99,14 @@ impl Phase {
 
     /// Two HG lobes, `w1 HG(g1) + (1 - w1) HG(g2)`; each `g` is clamped as
     /// in [`Phase::hg`]. Errors: a non-finite `g`, or `w1` outside `[0, 1]`.
-    pub fn hg2(g1: f32, g2: f32, w1: f32) -> Result<Phase, String> {
+    pub fn hg2(g1: f32, g2: f32, w1: f32) -> Result<Phase> {
         let lobe = |g: f32| {
             if g.is_finite() {
                 Ok(HenyeyGreenstein::new(g))
             } else {
-                Err(format!("HG asymmetry g must be finite, got {g}"))
+                Err(Error::invalid(format!(
+                    "HG asymmetry g must be finite, got {g}"
+                )))
             }
         };
         Ok(Phase::TwoHg(Blend::new(lobe(g1)?, lobe(g2)?, w1)?))
@@ -111,7 +114,7 @@ impl Phase {
 
     /// Draine (2003) with asymmetry-like `g` (clamped as in [`Phase::hg`])
     /// and `alpha >= 0`; see [`Draine::new`].
-    pub fn draine(g: f32, alpha: f32) -> Result<Phase, String> {
+    pub fn draine(g: f32, alpha: f32) -> Result<Phase> {
         Ok(Phase::Draine(Draine::new(g, alpha)?))
     }
 
@@ -119,7 +122,7 @@ impl Phase {
     /// diameter `diameter_um` (micrometres), Jendersie and d'Eon (2023).
     /// Diameters outside the fit's range `[5, 50]` are refused, not
     /// clamped; see [`MieFit::new`].
-    pub fn mie(diameter_um: f32) -> Result<Phase, String> {
+    pub fn mie(diameter_um: f32) -> Result<Phase> {
         Ok(Phase::HgDraine(MieFit::new(diameter_um)?.blend()?))
     }
 
@@ -131,7 +134,7 @@ impl Phase {
     /// A piecewise-linear function of `mu` through the points
     /// `(cos_values[i], values[i])`, normalised to integrate to 1; see
     /// [`TabulatedPhase::new`] for what is accepted.
-    pub fn table(cos_values: &[f32], values: &[f32]) -> Result<Phase, String> {
+    pub fn table(cos_values: &[f32], values: &[f32]) -> Result<Phase> {
         Ok(Phase::Table(Arc::new(TabulatedPhase::new(
             cos_values, values,
         )?)))
@@ -140,10 +143,10 @@ impl Phase {
     /// [`Phase::table`] from a text file of two columns, `cos(theta)` and
     /// value, separated by whitespace or a comma; `#` starts a comment.
     /// Errors name the file and, for a bad row, the line.
-    pub fn read_table(path: impl AsRef<Path>) -> Result<Phase, String> {
+    pub fn read_table(path: impl AsRef<Path>) -> Result<Phase> {
         let path = path.as_ref();
         let (cos, values) = table_file::read(path)?;
-        Phase::table(&cos, &values).map_err(|e| format!("{}: {e}", path.display()))
+        Phase::table(&cos, &values).map_err(|e| Error::format(path, e))
     }
 
     /// Density per steradian for scattering-angle cosine `mu`.

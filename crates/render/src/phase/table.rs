@@ -3,6 +3,7 @@
 use std::f64::consts::PI;
 
 use super::Lobe;
+use crate::error::Error;
 
 /// The most rows a table may have (checked before anything is allocated
 /// for it): 1e6 rows resolve the forward peak of any droplet size to well
@@ -49,10 +50,12 @@ impl TabulatedPhase {
     /// - values finite and `>= 0`, not all 0; any positive scale (they are
     ///   normalised);
     /// - 2 to [`MAX_TABLE_ROWS`] rows, as many values as cosines.
-    pub fn new(cos_values: &[f32], values: &[f32]) -> Result<Self, String> {
-        Self::build(cos_values, values).map_err(|e| match e.row {
-            Some(row) => format!("phase table row {row}: {}", e.message),
-            None => format!("phase table: {}", e.message),
+    pub fn new(cos_values: &[f32], values: &[f32]) -> crate::error::Result<Self> {
+        Self::build(cos_values, values).map_err(|e| {
+            Error::invalid(match e.row {
+                Some(row) => format!("phase table row {row}: {}", e.message),
+                None => format!("phase table: {}", e.message),
+            })
         })
     }
 

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use super::table::{validate, MAX_TABLE_ROWS};
+use crate::error::{Error, Result};
 
 /// Files larger than this are refused before reading: 1e6 rows of two
 /// numbers with generous formatting and comments fit well within it.
@@ -10,20 +11,21 @@ const MAX_FILE_BYTES: u64 = 128 << 20;
 
 /// The columns of a table file: one row per line, `cos(theta)` and value
 /// separated by a comma or whitespace; `#` starts a comment; blank lines
-/// are skipped. Errors are `FILE:LINE: what` (or `FILE: what` for the
-/// whole table), with the checks of `TabulatedPhase::new` applied here
-/// so that they too name the line.
-pub(super) fn read(path: &Path) -> Result<(Vec<f32>, Vec<f32>), String> {
-    let name = path.display();
+/// are skipped. Errors name the file and, for a row, its line
+/// (`FILE:LINE: what`), with the checks of `TabulatedPhase::new` applied
+/// here so that they too name the line.
+pub(super) fn read(path: &Path) -> Result<(Vec<f32>, Vec<f32>)> {
+    let at = |line: usize, message: String| Error::format_at(path, line, message);
     let size = std::fs::metadata(path)
-        .map_err(|e| format!("{name}: {e}"))?
+        .map_err(|e| Error::io(path, e))?
         .len();
     if size > MAX_FILE_BYTES {
-        return Err(format!(
-            "{name}: {size} bytes, more than a phase table may have ({MAX_FILE_BYTES})"
+        return Err(Error::format(
+            path,
+            format!("{size} bytes, more than a phase table may have ({MAX_FILE_BYTES})"),
         ));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{name}: {e}"))?;
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     let (mut cos, mut values, mut lines) = (Vec::new(), Vec::new(), Vec::new());
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
@@ -32,7 +34,7 @@ pub(super) fn read(path: &Path) -> Result<(Vec<f32>, Vec<f32>), String> {
             continue;
         }
         if cos.len() == MAX_TABLE_ROWS {
-            return Err(format!("{name}:{line}: more than {MAX_TABLE_ROWS} rows"));
+            return Err(at(line, format!("more than {MAX_TABLE_ROWS} rows")));
         }
         let fields: Vec<&str> = if content.contains(',') {
             content.split(',').map(str::trim).collect()
@@ -40,14 +42,17 @@ pub(super) fn read(path: &Path) -> Result<(Vec<f32>, Vec<f32>), String> {
             content.split_whitespace().collect()
         };
         let [c, v] = fields[..] else {
-            return Err(format!(
-                "{name}:{line}: expected two columns, cos(theta) and value; found {}",
-                fields.len()
+            return Err(at(
+                line,
+                format!(
+                    "expected two columns, cos(theta) and value; found {}",
+                    fields.len()
+                ),
             ));
         };
         let number = |s: &str| {
             s.parse::<f32>()
-                .map_err(|_| format!("{name}:{line}: '{s}' is not a number"))
+                .map_err(|_| at(line, format!("'{s}' is not a number")))
         };
         cos.push(number(c)?);
         values.push(number(v)?);
@@ -56,8 +61,8 @@ pub(super) fn read(path: &Path) -> Result<(Vec<f32>, Vec<f32>), String> {
     match validate(&cos, &values) {
         Ok(()) => Ok((cos, values)),
         Err(e) => Err(match e.row {
-            Some(row) => format!("{name}:{}: {}", lines[row], e.message),
-            None => format!("{name}: {}", e.message),
+            Some(row) => at(lines[row], e.message),
+            None => Error::format(path, e.message),
         }),
     }
 }
