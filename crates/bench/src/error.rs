@@ -162,7 +162,7 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
     v.push(Config {
         adaptive: Some(Adaptive {
             threshold: args.adaptive_threshold,
-            min_spp: cirrus_scene::defaults::MIN_SPP,
+            min_spp: cirrus_scene::description::RenderSpec::default().min_spp(),
         }),
         ..default(&format!("adaptive {}%", 100.0 * args.adaptive_threshold))
     });

@@ -23,10 +23,13 @@
 //! 4 bytes of state per leaf, one f32 per tile.
 
 use crate::bounds::build_pyramid;
-use crate::convert::{brick_bounds, empty_volume};
-use crate::layout::{BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS, MAX_BRICK_INDEX};
+use crate::cell_bounds::brick_bounds;
+use crate::layout::{
+    BrickRef, Precision, BRICK, BRICK_LOG2, BRICK_VOXELS, MAX_BRICK_INDEX, MAX_MAP_BRICKS,
+};
+use crate::stages::Stages;
 use crate::volume::{Atlas, BrickVolume, SourceInfo};
-use crate::{BrickError, MAX_MAP_BRICKS};
+use crate::BrickError;
 use cirrus_vdb::{BitMask, Coord, CoordBBox, LeafSink};
 use glam::IVec3;
 use rayon::prelude::*;
@@ -135,7 +138,7 @@ impl Builder {
         precision: Precision,
     ) -> Result<Start, BrickError> {
         let Some(bbox) = bbox else {
-            return Ok(Start::Empty(empty_volume(precision, active_voxels)));
+            return Ok(Start::Empty(BrickVolume::empty(precision, active_voxels)));
         };
         // Trilinear support reaches one voxel past the active box on each side.
         let lo = IVec3::from_array(bbox.min.to_array()) - 1;
@@ -267,13 +270,10 @@ impl Builder {
     /// Numbers and compacts the stored bricks, settles the map and builds
     /// the bounds pyramid.
     pub fn finish(self) -> Result<BrickVolume, BrickError> {
-        self.finish_timed(&crate::stream::Stages(None))
+        self.finish_timed(&Stages::silent())
     }
 
-    pub(crate) fn finish_timed(
-        mut self,
-        clock: &crate::stream::Stages,
-    ) -> Result<BrickVolume, BrickError> {
+    pub(crate) fn finish_timed(mut self, clock: &Stages) -> Result<BrickVolume, BrickError> {
         // 1. Stored bricks in leaf order.
         let mut stored = 0u32;
         for s in self.states.iter_mut() {

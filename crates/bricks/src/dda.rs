@@ -52,9 +52,6 @@ use crate::volume::BrickVolume;
 use crate::voxel_of::voxel_of;
 use glam::{IVec3, Vec3};
 
-/// A cell with `minorant >= TIGHT_ENOUGH * majorant` is not refined.
-pub const TIGHT_ENOUGH: f32 = 0.5;
-
 /// A ray in a volume's local index space, clipped to the volume's box, and
 /// the walk's position `t` along it: what every cell walk over a
 /// [`CellPartition`] shares (the segment walk here, the lattice march in

@@ -26,10 +26,11 @@
 use glam::{IVec3, Vec3};
 
 use crate::bounds::{build_pyramid, BoundsLevel, CELL_LOG2};
-use crate::convert::BOUND_SLACK;
+use crate::cell_bounds::BOUND_SLACK;
+use crate::layout::MAX_MAP_BRICKS;
 use crate::layout::{BRICK, BRICK_LOG2};
 use crate::volume::{Atlas, BrickVolume, SourceInfo};
-use crate::{BrickError, MAX_MAP_BRICKS};
+use crate::BrickError;
 
 impl BrickVolume {
     /// The shell of this volume for displacements of up to `radius`

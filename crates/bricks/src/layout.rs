@@ -126,3 +126,7 @@ mod tests {
         assert_eq!(BrickRef::decode(3 << 30), BrickRef::Empty);
     }
 }
+
+/// Largest brick map a conversion builds: 2^27 bricks (512 MiB of map,
+/// 64 Gi voxels of bounds), far past production clouds.
+pub const MAX_MAP_BRICKS: u64 = 1 << 27;

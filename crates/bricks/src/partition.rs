@@ -28,10 +28,11 @@
 //! (2^27 bricks), 20 KiB for the corpus cloud.
 
 use crate::bounds::{BoundsLevel, CELL_LOG2};
-use crate::dda::TIGHT_ENOUGH;
-use crate::volume::BrickVolume;
 use glam::IVec3;
 use rayon::prelude::*;
+
+/// A cell with `minorant >= TIGHT_ENOUGH * majorant` is not refined.
+pub const TIGHT_ENOUGH: f32 = 0.5;
 
 /// Flag of an empty level-1 cell's code; the low 7 bits are its distance.
 const EMPTY: u8 = 0x80;
@@ -87,13 +88,14 @@ impl CellPartition {
     }
 }
 
-impl BrickVolume {
-    /// The partition the walk uses when it refines cells whose slack
-    /// exceeds `split` density x voxels, and walks level-0 cells whose
-    /// slack exceeds `voxel_split` voxel by voxel.
-    pub fn partition(&self, split: f32, voxel_split: f32) -> CellPartition {
+impl CellPartition {
+    /// The partition of a bounds pyramid (`levels`, finest first) that the
+    /// walk uses when it refines cells whose slack exceeds `split` density
+    /// x voxels, and walks level-0 cells whose slack exceeds `voxel_split`
+    /// voxel by voxel.
+    pub fn refined(levels: &[BoundsLevel], split: f32, voxel_split: f32) -> CellPartition {
         let split = split.max(0.0);
-        let Some(level0) = self.levels.first() else {
+        let Some(level0) = levels.first() else {
             return CellPartition {
                 dims: [0; 3],
                 levels: Vec::new(),
@@ -101,10 +103,10 @@ impl BrickVolume {
             };
         };
         let dims = level0.dims.map(|d| d.div_ceil(2));
-        let top = self.levels.len() - 1;
+        let top = levels.len() - 1;
         let table = if top >= 1 {
-            let mut table = kept_levels(&self.levels, split);
-            mark_empty_distances(&self.levels[1], &mut table);
+            let mut table = kept_levels(levels, split);
+            mark_empty_distances(&levels[1], &mut table);
             table
         } else {
             vec![0u8; dims.iter().map(|&d| d as usize).product()]
@@ -117,7 +119,7 @@ impl BrickVolume {
     }
 }
 
-impl BrickVolume {
+impl CellPartition {
     /// The partition a ray march uses: every cell holding density is kept
     /// at `level` (clamped to the pyramid's levels), never refined by its
     /// bounds, and no cell is walked voxel by voxel; empty level-1 cells
@@ -127,9 +129,9 @@ impl BrickVolume {
     /// points inside it, and the lookups it adds are those of the empty
     /// voxels sharing a kept cell with density, which return at the brick
     /// map.
-    pub fn occupancy_partition(&self, level: usize) -> CellPartition {
-        let mut p = self.partition(f32::INFINITY, f32::INFINITY);
-        let top = self.levels.len().saturating_sub(1);
+    pub fn occupancy(levels: &[BoundsLevel], level: usize) -> CellPartition {
+        let mut p = CellPartition::refined(levels, f32::INFINITY, f32::INFINITY);
+        let top = levels.len().saturating_sub(1);
         let code = level.min(top) as u8;
         for c in p.levels.iter_mut().filter(|c| **c & EMPTY == 0) {
             *c = code;

@@ -5,10 +5,12 @@
 
 use crate::build::{Builder, Start};
 use crate::convert::convert;
+use crate::density_grid::{require_density, require_float};
 use crate::layout::Precision;
+use crate::stages::Stages;
 use crate::volume::BrickVolume;
 use crate::BrickError;
-use cirrus_vdb::{DecodeError, Format, GridClass, ValueType, VolumeFile};
+use cirrus_vdb::{DecodeError, Format, ValueType, VolumeFile};
 
 /// The precision a render straight from a `.vdb` or `.nvdb` keeps its
 /// stored bricks at. f16 halves the atlas against f32; its rounding error
@@ -34,30 +36,16 @@ pub fn convert_file(
         // NanoVDB (or an index the reader refuses with its own error).
         return convert(&file.read_grid(index)?, precision);
     };
-    if info.value_type != Some(ValueType::Float) {
-        return Err(BrickError::Unsupported(format!(
-            "grid {:?} holds {} values; only float grids convert",
-            info.name,
-            info.value_type
-                .map_or(info.type_name.as_str(), |t| t.name())
-        )));
-    }
+    require_float(
+        &info.name,
+        info.value_type == Some(ValueType::Float),
+        info.value_type
+            .map_or(info.type_name.as_str(), |t| t.name()),
+    )?;
     let clock = Stages::start();
     let mut stream = file.stream_grid::<f32>(index)?;
     clock.lap("topology");
-    if stream.class == GridClass::LevelSet {
-        return Err(BrickError::Unsupported(format!(
-            "grid {:?} is a level set (signed distances, not density); convert it to a fog volume first",
-            stream.name
-        )));
-    }
-    let background = stream.topology.background;
-    if background != 0.0 {
-        return Err(BrickError::Unsupported(format!(
-            "grid {:?} has background {background}; a density grid needs background 0",
-            stream.name
-        )));
-    }
+    require_density(&stream.name, stream.class, stream.topology.background)?;
     let (name, transform) = (stream.name.clone(), stream.transform);
     let topo = &mut stream.topology;
     let mut volume = match Builder::start(
@@ -87,41 +75,4 @@ pub fn convert_file(
     volume.index_to_world = transform.index_to_world_matrix();
     volume.info.grid_name = name;
     Ok(volume)
-}
-
-/// Stage times on stderr when `CIRRUS_TIMING` is set (for benchmarks):
-/// wall time, and the process's CPU time where /proc says it.
-pub(crate) struct Stages(pub(crate) Option<std::cell::Cell<(std::time::Instant, f64)>>);
-
-fn cpu_seconds() -> f64 {
-    // utime and stime, fields 14 and 15 of /proc/self/stat, in 1/100 s.
-    std::fs::read_to_string("/proc/self/stat")
-        .ok()
-        .and_then(|s| {
-            let rest = &s[s.rfind(')')? + 2..];
-            let f: Vec<&str> = rest.split(' ').collect();
-            Some((f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?) / 100.0)
-        })
-        .unwrap_or(0.0)
-}
-
-impl Stages {
-    pub fn start() -> Self {
-        Stages(
-            std::env::var_os("CIRRUS_TIMING")
-                .map(|_| std::cell::Cell::new((std::time::Instant::now(), cpu_seconds()))),
-        )
-    }
-    pub fn lap(&self, what: &str) {
-        if let Some(t) = &self.0 {
-            let (wall, cpu) = t.get();
-            let now = cpu_seconds();
-            eprintln!(
-                "  {what}: {:.3} s ({:.2} s CPU)",
-                wall.elapsed().as_secs_f64(),
-                now - cpu
-            );
-            t.set((std::time::Instant::now(), now));
-        }
-    }
 }

@@ -22,8 +22,9 @@
 use cirrus_vdb::{Coord, Tree, Value};
 use glam::{DMat4, IVec3, Vec3};
 
+use crate::layout::MAX_MAP_BRICKS;
 use crate::layout::{voxel_offset, BRICK, BRICK_LOG2};
-use crate::{BrickError, MAX_MAP_BRICKS};
+use crate::BrickError;
 
 /// Map code: the brick holds the background.
 const BACKGROUND: u32 = 0;

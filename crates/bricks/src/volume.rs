@@ -77,6 +77,44 @@ pub struct BrickVolume {
 }
 
 impl BrickVolume {
+    /// The partition the walk uses when it refines cells whose slack
+    /// exceeds `split` density x voxels, and walks level-0 cells whose
+    /// slack exceeds `voxel_split` voxel by voxel
+    /// ([`CellPartition::refined`]).
+    pub fn partition(&self, split: f32, voxel_split: f32) -> CellPartition {
+        CellPartition::refined(&self.levels, split, voxel_split)
+    }
+
+    /// The partition a ray march uses ([`CellPartition::occupancy`]).
+    pub fn occupancy_partition(&self, level: usize) -> CellPartition {
+        CellPartition::occupancy(&self.levels, level)
+    }
+
+    /// A volume with no bricks (an empty grid) of `active_voxels` active
+    /// voxels (all zero: tiles of density 0).
+    pub(crate) fn empty(precision: Precision, active_voxels: u64) -> BrickVolume {
+        let atlas = match precision {
+            Precision::F32 => Atlas::F32(Vec::new().into()),
+            Precision::F16 => Atlas::F16(Vec::new().into()),
+            Precision::U8 => Atlas::U8(Vec::new().into()),
+        };
+        BrickVolume {
+            origin: IVec3::ZERO,
+            dims: [0; 3],
+            index_to_world: glam::DMat4::IDENTITY,
+            map: Vec::new().into(),
+            constants: Vec::new().into(),
+            ranges: Vec::new().into(),
+            atlas,
+            levels: Vec::new(),
+            info: SourceInfo {
+                active_voxels,
+                ..Default::default()
+            },
+            finest_partition: Default::default(),
+        }
+    }
+
     pub fn precision(&self) -> Precision {
         self.atlas.precision()
     }

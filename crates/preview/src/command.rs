@@ -8,7 +8,6 @@ use std::fmt::Display;
 use std::path::Path;
 
 use cirrus_scene::Overrides;
-use glam::{DVec3, Vec3};
 
 /// `cirrus render INPUT -o STEM.exr --png STEM.png FLAGS...` for `o`.
 pub fn render_command(input: &Path, o: &Overrides) -> String {
@@ -34,13 +33,13 @@ pub fn render_command(input: &Path, o: &Overrides) -> String {
     flag("seed", o.seed.map(text));
     flag("integrator", o.integrator.map(|i| i.name().to_string()));
     flag("step", o.step.map(text));
-    flag("camera-from", o.camera_from.map(dvec));
-    flag("camera-to", o.camera_to.map(dvec));
-    flag("camera-up", o.camera_up.map(vec));
+    flag("camera-from", o.camera_from.map(triple));
+    flag("camera-to", o.camera_to.map(triple));
+    flag("camera-up", o.camera_up.map(triple));
     flag("fov", o.fov.map(text));
-    flag("sun-dir", o.sun_dir.map(vec));
-    flag("sun-irradiance", o.sun_irradiance.map(vec));
-    flag("env-radiance", o.env_radiance.map(vec));
+    flag("sun-dir", o.sun_dir.map(triple));
+    flag("sun-irradiance", o.sun_irradiance.map(triple));
+    flag("env-radiance", o.env_radiance.map(triple));
     flag("env-intensity", o.env_intensity.map(text));
     flag("density-scale", o.density_scale.map(text));
     flag("albedo", o.albedo.map(text));
@@ -63,12 +62,9 @@ fn text(x: impl Display) -> String {
     x.to_string()
 }
 
-fn vec(v: Vec3) -> String {
-    format!("{},{},{}", v.x, v.y, v.z)
-}
-
-fn dvec(v: DVec3) -> String {
-    format!("{},{},{}", v.x, v.y, v.z)
+fn triple(v: [impl Display; 3]) -> String {
+    let [x, y, z] = v;
+    format!("{x},{y},{z}")
 }
 
 /// A POSIX shell word for `s`: as it is when it is plainly safe, else in
@@ -93,8 +89,8 @@ mod tests {
             spp: Some(16),
             seed: Some(0),
             g: Some(-0.3),
-            camera_from: Some(DVec3::new(1.0, -2.5, 0.1)),
-            camera_to: Some(DVec3::ZERO),
+            camera_from: Some([1.0, -2.5, 0.1]),
+            camera_to: Some([0.0; 3]),
             sun: Some(false),
             ..Default::default()
         };

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{RenderControl, Rendered};
 use cirrus_scene::description::SceneDescription;
-use cirrus_scene::{defaults as d, Overrides, Result, Scene, VolumeCache};
+use cirrus_scene::{Overrides, Result, Scene, VolumeCache};
 use glam::Vec3;
 
 use crate::view::{sun_angles, CameraView, Lighting, Mode, SunView, View};
@@ -43,7 +43,7 @@ impl Source {
             ..Default::default()
         });
         let desc = scene.description().clone();
-        let base_res = desc.camera.res.unwrap_or(d::RES);
+        let base_res = desc.camera.res();
         let lighting = lighting(&desc);
         let mut view = initial_view(&desc);
         let mut cache = VolumeCache::default();
@@ -53,7 +53,7 @@ impl Source {
             let prepared = scene.prepare(&mut cache, None)?;
             let c = &prepared.scene.camera;
             let world = |p: Vec3| (p.as_dvec3() + prepared.centre).to_array();
-            let (from, to) = match (desc.camera.from, desc.camera.to) {
+            let (from, to) = match (desc.camera.camera_from, desc.camera.camera_to) {
                 (Some(from), Some(to)) => (from, to),
                 _ => (world(c.from()), world(c.to())),
             };
@@ -66,7 +66,7 @@ impl Source {
             if let [m] = prepared.scene.media.instances() {
                 view.density_scale = Some(m.density_scale);
                 view.albedo = Some(m.albedo.x);
-                view.g = Some(desc.volumes[0].g.unwrap_or(d::G));
+                view.g = Some(desc.volumes[0].g());
             }
         }
         let volume = path.extension().is_none_or(|e| e != "toml");
@@ -88,17 +88,16 @@ impl Source {
 fn initial_view(desc: &SceneDescription) -> View {
     let c = &desc.camera;
     let sun = desc.sun.clone().unwrap_or_default();
-    let (azimuth, elevation) =
-        sun_angles(Vec3::from_array(sun.direction.unwrap_or(d::SUN_DIRECTION)));
+    let (azimuth, elevation) = sun_angles(Vec3::from_array(sun.sun_dir()));
     View {
         camera: CameraView {
             from: [0.0, 0.0, 1.0],
             to: [0.0; 3],
-            up: c.up.unwrap_or(d::CAMERA_UP),
-            fov: c.fov.unwrap_or(d::FOV),
+            up: c.camera_up(),
+            fov: c.fov(),
         },
         sun: SunView {
-            enabled: sun.enabled.unwrap_or(true),
+            enabled: sun.sun(),
             azimuth,
             elevation,
             intensity: 1.0,
@@ -107,7 +106,7 @@ fn initial_view(desc: &SceneDescription) -> View {
         density_scale: None,
         albedo: None,
         g: None,
-        exposure: desc.output.exposure.unwrap_or(d::EXPOSURE),
+        exposure: desc.output.exposure(),
         integrator: Mode::Auto,
         interactive: false,
         denoise: false,
@@ -120,12 +119,12 @@ fn lighting(desc: &SceneDescription) -> Lighting {
     let sun = desc.sun.clone().unwrap_or_default();
     let env = desc.environment.clone().unwrap_or_default();
     Lighting {
-        sun_irradiance: Vec3::from_array(sun.irradiance.unwrap_or(d::SUN_IRRADIANCE)),
+        sun_irradiance: Vec3::from_array(sun.sun_irradiance()),
         sky_radiance: env
-            .map
+            .env_map
             .is_none()
-            .then(|| Vec3::from_array(env.radiance.unwrap_or(d::SKY_RADIANCE))),
-        sky_map_intensity: env.intensity.unwrap_or(d::SKY_INTENSITY),
+            .then(|| Vec3::from_array(env.env_radiance())),
+        sky_map_intensity: env.env_intensity(),
     }
 }
 

@@ -211,9 +211,9 @@ impl View {
         let (integrator, step) = self.integrator_now();
         let mut o = Overrides {
             res: Some(res),
-            camera_from: Some(DVec3::from_array(c.from)),
-            camera_to: Some(DVec3::from_array(c.to)),
-            camera_up: Some(Vec3::from_array(c.up)),
+            camera_from: Some(c.from),
+            camera_to: Some(c.to),
+            camera_up: Some(c.up),
             fov: Some(c.fov),
             density_scale: self.density_scale.map(Colour::Grey),
             albedo: self.albedo.map(Colour::Grey),
@@ -225,13 +225,13 @@ impl View {
             ..Default::default()
         };
         if self.sun.enabled {
-            o.sun_dir = Some(sun_direction(self.sun.azimuth, self.sun.elevation));
-            o.sun_irradiance = Some(lighting.sun_irradiance * self.sun.intensity);
+            o.sun_dir = Some(sun_direction(self.sun.azimuth, self.sun.elevation).to_array());
+            o.sun_irradiance = Some((lighting.sun_irradiance * self.sun.intensity).to_array());
         } else {
             o.sun = Some(false);
         }
         match lighting.sky_radiance {
-            Some(radiance) => o.env_radiance = Some(radiance * self.sky),
+            Some(radiance) => o.env_radiance = Some((radiance * self.sky).to_array()),
             None => o.env_intensity = Some(lighting.sky_map_intensity * self.sky),
         }
         o

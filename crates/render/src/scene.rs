@@ -135,7 +135,7 @@ impl Default for RenderSettings {
             integrator: IntegratorKind::Path,
             transmittance: TransmittanceEstimator::Residual,
             majorant: MajorantMode::Hierarchy,
-            budget: Budget::Spp(16),
+            budget: Budget::Spp(64),
             seed: 0,
             sampler: SamplerKind::Sobol,
             adaptive: None,

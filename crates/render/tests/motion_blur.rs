@@ -302,3 +302,50 @@ fn a_closed_shutter_or_no_velocity_renders_bit_identical() {
 fn bits(rgba: &[[f32; 4]]) -> Vec<[u32; 4]> {
     rgba.iter().map(|p| p.map(f32::to_bits)).collect()
 }
+
+/// A velocity in voxels moves the field by that many of the velocity
+/// grid's own voxels: on a grid of 2-unit voxels, -2 voxels a frame is -4
+/// world units a frame, and the same value read as world units is not.
+#[test]
+fn voxel_velocities_count_the_velocity_grid_voxels() {
+    let volume = box_volume();
+    let coarse = |v: [f32; 3], unit: VelocityUnit| {
+        let mut tree = Tree::new([0.0f32; 3]);
+        for x in -4..16 {
+            for y in -4..12 {
+                for z in -4..16 {
+                    tree.set_value_on(Coord::new(x, y, z), v);
+                }
+            }
+        }
+        let to_world = DMat4::from_scale(DVec3::splat(2.0));
+        Velocity {
+            grid: Arc::new(VelocityGrid::from_tree("vel", &tree, to_world, |v| v).unwrap()),
+            unit,
+            scale: 1.0,
+        }
+    };
+    let moving = |velocity: &Velocity| {
+        BrickField::new(&volume, DMat4::IDENTITY, DVec3::ZERO)
+            .with_motion(velocity, SHUTTER)
+            .unwrap()
+    };
+    let world = moving(&constant_velocity([V, 0.0, 0.0]));
+    let voxels = moving(&coarse([0.5 * V, 0.0, 0.0], VelocityUnit::Voxels));
+    let as_world = moving(&coarse([0.5 * V, 0.0, 0.0], VelocityUnit::World));
+    let (mut compared, mut differ) = (0, 0);
+    for i in 0..40 {
+        let p = Vec3::new(10.0 + 0.2 * i as f32, 4.0, 8.0);
+        for t in [0.25f32, 0.5, 0.75] {
+            let (a, b) = (world.density_at(p, t), voxels.density_at(p, t));
+            assert!((a - b).abs() <= 1e-5, "{p} at {t}: {a} vs {b}");
+            compared += 1;
+            differ += usize::from((as_world.density_at(p, t) - a).abs() > 1e-3);
+        }
+    }
+    assert_eq!(compared, 120);
+    assert!(
+        differ > 20,
+        "the unit must matter: {differ} of {compared} differ"
+    );
+}

@@ -1,12 +1,14 @@
-//! The scene description: exactly the TOML format of a scene file (and the
-//! JSON form the Python bindings pass for a dict).
+//! Every setting, declared once ([`declare_settings!`](crate::declare)):
+//! its table and key in a scene file, its flag, its type, its default, its
+//! help and its Python keyword. From this one declaration come the scene
+//! description (exactly the TOML format of a scene file, and the JSON form
+//! the Python bindings pass for a dict), the [`Overrides`] written over it,
+//! the command line's flags, the defaults and the README's table.
 //!
-//! Every table and field maps to a `cirrus render` flag (the README's
-//! "Scene files" section has the table); [`Overrides`](crate::Overrides)
-//! written over it win. Every field is optional here; the defaults are
-//! applied when the description is resolved (`defaults.rs`). Unknown keys
-//! and wrong types are errors that name the file, the key, and its line
-//! and column (serde's `deny_unknown_fields`; toml's errors carry the span).
+//! Every setting is optional in a description; its getter applies the
+//! declared default. Unknown keys and wrong types are errors that name the
+//! file, the key, and its line and column (serde's `deny_unknown_fields`;
+//! toml's errors carry the span).
 
 use std::path::{Path, PathBuf};
 
@@ -16,109 +18,202 @@ use cirrus_render::{
 };
 use serde::Deserialize;
 
+use crate::declare::declare_settings;
 use crate::error::{Error, Result};
+#[cfg(feature = "clap")]
+use crate::parse;
 
-/// A whole scene file.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SceneDescription {
-    #[serde(default)]
-    pub output: OutputSpec,
-    #[serde(default)]
-    pub render: RenderSpec,
-    #[serde(default)]
-    pub camera: CameraSpec,
-    /// Absent: the `--sun-*` defaults; `enabled = false`: no sun.
-    pub sun: Option<SunSpec>,
-    /// Absent: the `--env-radiance` default.
-    pub environment: Option<EnvironmentSpec>,
-    #[serde(default, rename = "volume")]
-    pub volumes: Vec<VolumeSpec>,
-}
+declare_settings! {
+    /// `[output]`: where the image goes.
+    table output: OutputSpec, OutputFlags, one {
+    /// Output EXR (RGBA f32; alpha = 1 - camera-ray transmittance), written
+    /// whole or not at all.
+    output as "exr": PathBuf, flag(short, long),
+        unset("none: a library caller keeps the image"),
+        example(PathBuf::from("a.exr"));
+    /// Also write an sRGB PNG preview.
+    png: PathBuf, flag(long), example(PathBuf::from("a.png"));
+    /// Exposure of the PNG preview, in stops.
+    exposure: f32, flag(long, allow_hyphen_values = true), default(0.0), example(1.5);
+    /// Write render statistics as JSON.
+    stats: PathBuf, flag(long), example(PathBuf::from("a.json"));
+    /// AOV layers to add to the EXR: albedo, depth, emission, direct,
+    /// samples.
+    aov: Vec<Aov>, flag(long, value_delimiter = ',', value_enum),
+        unset("none"), example(vec![Aov::Depth]);
+    /// Render only the pixels [x0, x1) x [y0, y1) into a full-size EXR with
+    /// a data window (merge tiles with `cirrus merge`).
+    crop: [u32; 4], flag(long, value_parser = parse::crop),
+        unset("the whole image"), example([0, 0, 4, 4]);
+    }
 
-/// `-o`, `--png`, `--exposure`, `--stats`, `--aov`, `--crop`.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OutputSpec {
-    pub exr: Option<PathBuf>,
-    pub png: Option<PathBuf>,
-    pub exposure: Option<f32>,
-    pub stats: Option<PathBuf>,
-    pub aov: Option<Vec<Aov>>,
-    /// `[x0, y0, x1, y1]`, pixels, half-open.
-    pub crop: Option<[u32; 4]>,
-}
+    /// `[render]`: how to render.
+    table render: RenderSpec, RenderFlags, one {
+    /// Samples per pixel.
+    spp: u32, flag(long, conflicts_with = "time"), default(64), example(3);
+    /// Render passes until this many seconds are spent (instead of spp).
+    time: f64, flag(long), unset("off"), example(0.5);
+    /// Same seed, same image, on any thread count.
+    seed: u64, flag(long), default(0), example(7);
+    /// Sample numbers: Owen-scrambled Sobol points for the first path
+    /// vertices, or independent random numbers.
+    sampler: SamplerKind, flag(long, value_enum), default(SamplerKind::Sobol),
+        example(SamplerKind::Random);
+    /// Adaptive sampling: a pixel stops once the relative standard error
+    /// of its mean is below this (e.g. 0.02); with --time, passes go to the
+    /// pixels of highest error.
+    noise_threshold: f32, flag(long), unset("off"), example(0.05);
+    /// Samples every pixel takes before adaptive sampling may stop it.
+    min_spp: u32, flag(long), default(16), example(4);
+    /// The integrator: unbiased path tracing, or ray marching (single
+    /// scattering; two-pass over a cached light grid).
+    integrator: IntegratorKind, flag(long, value_enum), default(IntegratorKind::Path),
+        example(IntegratorKind::RayMarch);
+    /// Shadow-ray transmittance estimator.
+    transmittance: TransmittanceEstimator, flag(long, value_enum),
+        default(TransmittanceEstimator::Residual), example(TransmittanceEstimator::Ratio);
+    /// Majorants for tracking: the brick hierarchy, one global majorant
+    /// (Mitsuba-like), or whichever a probe of the scene finds cheaper.
+    majorant: MajorantMode, flag(long, value_enum), default(MajorantMode::Auto),
+        example(MajorantMode::Global);
+    /// Real scattering events per path (0: only the sky through the volume,
+    /// 1: single scattering).
+    max_depth: u32, flag(long), unset("unlimited, ended by Russian roulette"), example(1);
+    /// Ray-march step in voxels.
+    step: f32, flag(long), default(0.5), example(2.0);
+    /// The ray marchers' shadow-ray step in voxels, as vdb_render's
+    /// -shadowstep.
+    shadow_step: f32, flag(long), unset("the step"), example(3.0);
+    /// Majorant cells are refined while crossing one would cost more than
+    /// this many extra null collisions (optical depth; Blender Cycles uses
+    /// 1.442; 0 refines to the finest 4^3 cells).
+    refine_optical_depth: f32, flag(long), default(1.0), example(0.0);
+    /// Denoise with Intel Open Image Denoise 2.x (guided by the albedo
+    /// AOV); the EXR keeps the noisy image as `noisy.R/G/B`.
+    denoise: bool, flag(long, num_args = 0, default_missing_value = "true"),
+        default(false), example(true);
+    /// Motion blur: the shutter's open and close times in frames around
+    /// the frame, e.g. -0.25,0.25 (centred) or 0,0.5.
+    shutter: [f32; 2], flag(long, value_parser = parse::shutter, allow_hyphen_values = true),
+        default([0.0, 0.0]), example([-0.25, 0.25]);
+    /// Frames A-B[:STEP]: the frame number replaces `####` or `%04d` in
+    /// every input and output path.
+    frames: String, flag(long), unset("one frame, no pattern"), example("1-2".into());
+    }
 
-/// `--spp`, `--time`, `--seed`, `--integrator`, `--transmittance`,
-/// `--majorant`, `--max-depth`, `--step`, `--refine-optical-depth`.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RenderSpec {
-    pub spp: Option<u32>,
-    pub time: Option<f64>,
-    pub seed: Option<u64>,
-    /// `"sobol"` or `"random"` (`--sampler`).
-    pub sampler: Option<SamplerKind>,
-    /// Relative error at which a pixel stops (`--noise-threshold`).
-    pub noise_threshold: Option<f32>,
-    /// Samples before a pixel may stop (`--min-spp`).
-    pub min_spp: Option<u32>,
-    pub integrator: Option<IntegratorKind>,
-    pub transmittance: Option<TransmittanceEstimator>,
-    pub majorant: Option<MajorantMode>,
-    pub max_depth: Option<u32>,
-    pub step: Option<f32>,
-    /// The ray marchers' shadow-ray step in voxels (`--shadow-step`).
-    pub shadow_step: Option<f32>,
-    /// Majorant cells are refined while crossing one costs more than this
-    /// optical depth in null collisions (lone volumes).
-    pub refine_optical_depth: Option<f32>,
-    /// Denoise the image with Open Image Denoise, guided by the albedo AOV.
-    pub denoise: Option<bool>,
-    /// A frame range, `"A-B"` or `"A-B:STEP"`, for paths holding a frame
-    /// pattern (`####`, `%04d`).
-    pub frames: Option<String>,
-    /// `[open, close]` in frames around the frame (`--shutter`): motion
-    /// blur from the volumes' velocity grids.
-    pub shutter: Option<[f32; 2]>,
-}
+    /// `[camera]`: where the image is seen from.
+    table camera: CameraSpec, CameraFlags, one {
+    /// Image size, WxH.
+    res: (u32, u32), serde(default, deserialize_with = "crate::parse::resolution_field"),
+        flag(long, value_parser = parse::resolution), default((512, 512)), example((8, 6));
+    /// Camera position (world space).
+    camera_from as "from": [f64; 3],
+        flag(long, value_parser = parse::triple, allow_hyphen_values = true, requires = "camera_to"),
+        unset("framed on the volumes"), example([400.0, 80.0, 500.0]);
+    /// The point the camera looks at (world space).
+    camera_to as "to": [f64; 3],
+        flag(long, value_parser = parse::triple, allow_hyphen_values = true, requires = "camera_from"),
+        unset("framed on the volumes"), example([150.0, 80.0, 100.0]);
+    /// The camera's up direction.
+    camera_up as "up": [f32; 3], flag(long, value_parser = parse::vector, allow_hyphen_values = true),
+        default([0.0, 1.0, 0.0]), example([0.0, 0.0, 1.0]);
+    /// Vertical field of view in degrees.
+    fov: f32, flag(long), default(40.0), example(25.0);
+    }
 
-/// `--res`, `--camera-from`, `--camera-to`, `--camera-up`, `--fov`.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CameraSpec {
-    /// `"WxH"`, as the flag.
-    #[serde(default, deserialize_with = "resolution")]
-    pub res: Option<(u32, u32)>,
-    pub from: Option<[f64; 3]>,
-    pub to: Option<[f64; 3]>,
-    pub up: Option<[f32; 3]>,
-    pub fov: Option<f32>,
-}
+    /// `[sun]`: a directional light, optionally a small disc.
+    table sun: SunSpec, SunFlags, optional {
+    /// Whether there is a sun (`--no-sun`, Python `sun=False`: none).
+    sun as "enabled": bool,
+        flag(long = "no-sun", num_args = 0, default_missing_value = "false"),
+        default(true), example(false);
+    /// Direction the sunlight travels, from the sun toward the scene.
+    sun_dir as "direction": [f32; 3],
+        flag(long, value_parser = parse::vector, allow_hyphen_values = true),
+        default([0.7, -0.5, 0.5]), example([0.0, -1.0, 0.0]);
+    /// Sun irradiance on a surface facing it (W/m^2 per channel, Mitsuba's
+    /// `directional`).
+    sun_irradiance as "irradiance": [f32; 3],
+        flag(long, value_parser = parse::vector, allow_hyphen_values = true),
+        default([2.6, 2.5, 2.3]), example([1.0, 1.0, 1.0]);
+    /// Angular diameter of the sun in degrees (0: a delta light).
+    sun_angle as "angle": f32, flag(long), default(0.53), example(5.0);
+    }
 
-/// `--sun-dir`, `--sun-irradiance`, `--sun-angle`, `--no-sun`.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SunSpec {
-    pub enabled: Option<bool>,
-    /// The direction sunlight travels (from the sun toward the scene).
-    pub direction: Option<[f32; 3]>,
-    pub irradiance: Option<[f32; 3]>,
-    /// Angular diameter in degrees.
-    pub angle: Option<f32>,
-}
+    /// `[environment]`: light from every direction, constant or a map.
+    table environment: EnvironmentSpec, EnvironmentFlags, optional {
+    /// Constant sky radiance (0,0,0 for none); ignored when a map is given.
+    env_radiance as "radiance": [f32; 3],
+        flag(long, value_parser = parse::vector, allow_hyphen_values = true),
+        default([0.16, 0.22, 0.34]), example([1.0, 1.0, 1.0]);
+    /// A lat-long HDR sky (EXR) instead of the constant radiance (in a
+    /// scene file: relative to the file).
+    env_map as "map": PathBuf, flag(long), unset("none"),
+        example(PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/sky.exr")));
+    /// Rotation of the sky map about +Y, in degrees.
+    env_rotation as "rotation": f32, flag(long, allow_hyphen_values = true), default(0.0),
+        example(90.0);
+    /// Multiplier of the sky map's radiance.
+    env_intensity as "intensity": f32, flag(long), default(1.0), example(2.0);
+    }
 
-/// `--env-radiance`, `--env-map`, `--env-rotation`, `--env-intensity`.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EnvironmentSpec {
-    /// Constant radiance (ignored when a map is given).
-    pub radiance: Option<[f32; 3]>,
-    /// Lat-long EXR, relative to the scene file.
-    pub map: Option<PathBuf>,
-    /// Degrees about +Y.
-    pub rotation: Option<f32>,
-    pub intensity: Option<f32>,
+    /// `[[volume]]`: one volume instance; a flag applies to every volume.
+    table volumes as "volume": VolumeSpec, VolumeFlags, each {
+    /// The density grid.
+    grid as "density": String, flag(long),
+        unset("\"density\", else the first float grid"), example("temperature".into());
+    /// Extinction per unit density, in 1/world units: one number, or R,G,B
+    /// for a chromatic medium.
+    density_scale: Colour, flag(long, value_parser = parse::colour),
+        unset("0.5 / voxel size: density 1 is half a mean free path per voxel"),
+        example(Colour::Rgb([0.2, 0.3, 0.4]));
+    /// Single-scattering albedo: one number or R,G,B.
+    albedo: Colour, flag(long, value_parser = parse::colour), default(Colour::Grey(0.99)),
+        example(Colour::Grey(0.5));
+    /// Henyey-Greenstein asymmetry (of the first lobe of hg2; Draine's g).
+    g: f32, flag(long, allow_hyphen_values = true), default(0.6), example(0.2);
+    /// Phase function: hg, hg2 (two HG lobes), draine, mie (Jendersie and
+    /// d'Eon 2023's fit by droplet diameter), rayleigh, or table:FILE (two
+    /// columns, cos(theta) and value; in a scene file relative to the file).
+    phase: String, flag(long), default("hg".into()), example("rayleigh".into());
+    /// The second lobe of hg2.
+    g2: f32, flag(long, allow_hyphen_values = true), default(-0.3), example(0.1);
+    /// Weight of hg2's first lobe, in [0, 1].
+    lobe_weight: f32, flag(long), default(0.8), example(0.5);
+    /// Droplet diameter of mie, in micrometres (5 to 50).
+    droplet_diameter: f32, flag(long), default(20.0), example(8.0);
+    /// Draine's alpha.
+    draine_alpha: f32, flag(long), default(1.0), example(0.5);
+    /// The vec3 velocity grid moving the volume while the shutter is open.
+    velocity: String, flag(long), unset("\"vel\" or \"v\" if the file has one"),
+        example("velocity".into());
+    /// What velocity values measure: world units or velocity-grid voxels,
+    /// per frame.
+    velocity_unit: VelocityUnit, flag(long, value_enum), default(VelocityUnit::World),
+        example(VelocityUnit::Voxels);
+    /// Multiplies velocity values, e.g. 0.041667 (1/24) for per-second
+    /// velocities at 24 fps.
+    velocity_scale: f32, flag(long), default(1.0), example(2.0);
+    @file_only {
+        /// A .vdb, .nvdb or .cbrk file, relative to the scene file.
+        file: PathBuf;
+        /// Temperature grid name: blackbody emission.
+        temperature: Option<String>;
+        /// Blackbody parameters, `{ scale, offset, temperature_scale }`:
+        /// `Le = scale * Blackbody((T - offset) * temperature_scale)`.
+        blackbody: BlackbodySpec = serde(default);
+        /// Emission grid name: `value * emission_color * emission_scale`.
+        emission: Option<String>;
+        /// The emission grid's colour.
+        emission_color: Option<[f32; 3]>;
+        /// The emission grid's multiplier.
+        emission_scale: Option<f32>;
+        /// Object to world: `{ translate, rotate = { axis, degrees } or
+        /// euler = [x, y, z] (degrees, about X then Y then Z), scale }`,
+        /// applied scale, then rotate, then translate.
+        transform: TransformSpec = serde(default);
+    }
+    }
 }
 
 /// A number or an RGB triple.
@@ -152,54 +247,8 @@ impl std::fmt::Display for Colour {
     }
 }
 
-/// One volume instance. `--grid`, `--density-scale`, `--albedo` and `--g`
-/// given on the command line apply to every volume.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct VolumeSpec {
-    /// A .vdb, .nvdb or .cbrk file, relative to the scene file.
-    pub file: PathBuf,
-    /// Density grid name (default "density", else the first float grid).
-    pub density: Option<String>,
-    /// Temperature grid name: blackbody emission (see `blackbody`).
-    pub temperature: Option<String>,
-    /// Emission grid name: `value * emission_color * emission_scale`.
-    pub emission: Option<String>,
-    /// Velocity grid name (vec3), for motion blur when the shutter is
-    /// open (default: `vel` or `v` if the file has one).
-    pub velocity: Option<String>,
-    /// `"world"` (world units per frame, the default) or `"voxels"`
-    /// (velocity-grid voxels per frame).
-    pub velocity_unit: Option<VelocityUnit>,
-    /// Multiplies the velocity (1/24: per-second values at 24 fps).
-    pub velocity_scale: Option<f32>,
-    /// Extinction per unit density in 1/world units: one number, or one
-    /// per RGB channel (a chromatic medium).
-    pub density_scale: Option<Colour>,
-    pub albedo: Option<Colour>,
-    /// Mean cosine of the (first) Henyey-Greenstein lobe, or Draine's g.
-    pub g: Option<f32>,
-    /// `hg`, `hg2`, `draine`, `mie`, `rayleigh` or `table:FILE` (a
-    /// two-column text file of cos(theta) and value).
-    pub phase: Option<String>,
-    /// The second lobe of `hg2`.
-    pub g2: Option<f32>,
-    /// Weight of the first lobe of `hg2`, in [0, 1].
-    pub lobe_weight: Option<f32>,
-    /// Droplet diameter of `mie`, micrometres (5 to 50).
-    pub droplet_diameter: Option<f32>,
-    /// Draine's alpha.
-    pub draine_alpha: Option<f32>,
-    #[serde(default)]
-    pub transform: TransformSpec,
-    #[serde(default)]
-    pub blackbody: BlackbodySpec,
-    pub emission_color: Option<[f32; 3]>,
-    pub emission_scale: Option<f32>,
-}
-
 /// Object to world: scale, then rotate, then translate.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TransformSpec {
     pub translate: Option<[f64; 3]>,
@@ -212,14 +261,14 @@ pub struct TransformSpec {
     pub scale: Option<ScaleSpec>,
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AxisAngle {
     pub axis: [f64; 3],
     pub degrees: f64,
 }
 
-#[derive(Clone, Copy, Debug, Deserialize)]
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 #[serde(untagged)]
 pub enum ScaleSpec {
     Uniform(f64),
@@ -227,21 +276,12 @@ pub enum ScaleSpec {
 }
 
 /// pbrt-v4's blackbody parameters: `Le = scale * Blackbody((T - offset) * temperature_scale)`.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct BlackbodySpec {
     pub scale: Option<f32>,
     pub offset: Option<f32>,
     pub temperature_scale: Option<f32>,
-}
-
-fn resolution<'de, D: serde::Deserializer<'de>>(
-    d: D,
-) -> std::result::Result<Option<(u32, u32)>, D::Error> {
-    let s = String::deserialize(d)?;
-    crate::parse::resolution(&s)
-        .map(Some)
-        .map_err(serde::de::Error::custom)
 }
 
 impl SceneDescription {
@@ -276,7 +316,7 @@ impl SceneDescription {
                 v.phase = Some(format!("table:{}", dir.join(table).display()));
             }
         }
-        if let Some(map) = self.environment.as_mut().and_then(|e| e.map.as_mut()) {
+        if let Some(map) = self.environment.as_mut().and_then(|e| e.env_map.as_mut()) {
             *map = dir.join(&*map);
         }
     }
@@ -287,11 +327,14 @@ impl SceneDescription {
         for v in &mut self.volumes {
             v.file = substitute(&v.file, frame);
         }
-        if let Some(map) = self.environment.as_mut().and_then(|e| e.map.as_mut()) {
+        if let Some(map) = self.environment.as_mut().and_then(|e| e.env_map.as_mut()) {
             *map = substitute(map, frame);
         }
         let o = &mut self.output;
-        for path in [&mut o.exr, &mut o.png, &mut o.stats].into_iter().flatten() {
+        for path in [&mut o.output, &mut o.png, &mut o.stats]
+            .into_iter()
+            .flatten()
+        {
             *path = substitute(path, frame);
         }
     }

@@ -8,8 +8,13 @@ use cirrus_bricks::{
 };
 use cirrus_vdb::{GridInfo, GridTree, ValueType, VolumeFile};
 
-use crate::defaults::DENSITY_GRID;
 use crate::error::{Error, Result};
+
+/// The grid name looked for when none is given.
+pub const DENSITY_GRID: &str = "density";
+/// Velocity grids used when the shutter is open and none is named: the
+/// first vec3 grid with one of these names.
+pub const VELOCITY_GRIDS: [&str; 2] = ["vel", "v"];
 
 /// The grid to render or convert: the one named, else "density", else
 /// the first float grid.
@@ -98,15 +103,13 @@ pub fn is_cbrk(path: &Path) -> bool {
 
 /// The velocity grid of a moving volume: the one named (which must be a
 /// vec3 grid), else the first vec3 grid named `vel` or `v`
-/// ([`VELOCITY_GRIDS`](crate::defaults::VELOCITY_GRIDS)), else none.
+/// ([`VELOCITY_GRIDS`]), else none.
 pub fn choose_velocity(file: &VolumeFile, name: Option<&str>) -> Result<Option<usize>> {
     let grids = file.grids();
     let vec3 = |g: &GridInfo| matches!(g.value_type, Some(ValueType::Vec3f | ValueType::Vec3d));
     let Some(name) = name else {
         let by_name = |n: &str| grids.iter().position(|g| g.name == n && vec3(g));
-        return Ok(crate::defaults::VELOCITY_GRIDS
-            .iter()
-            .find_map(|n| by_name(n)));
+        return Ok(VELOCITY_GRIDS.iter().find_map(|n| by_name(n)));
     };
     let index = file
         .find_grid(name)

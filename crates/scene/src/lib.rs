@@ -7,7 +7,8 @@
 //!   the JSON form of a Python dict). [`Overrides`] are the flags of
 //!   `cirrus render` as plain optional fields written over it; with the
 //!   `clap` feature, [`SceneFlags`] and [`OutputFlags`] are their
-//!   command-line form. Every default lives in [`defaults`].
+//!   command-line form. Every setting is declared once, with its default
+//!   (`description.rs`, [`settings`]).
 //! - [`Scene`] holds a description and renders it: it resolves the
 //!   scene-wide [`SceneSettings`], plans each volume from its file's header,
 //!   culls the volumes no path can reach, reads only the grids that can
@@ -34,7 +35,7 @@
 //! ```
 
 pub mod cull;
-pub mod defaults;
+mod declare;
 mod denoise;
 pub mod dense;
 pub mod description;
@@ -52,13 +53,17 @@ mod prepare;
 mod scene;
 mod settings;
 
+pub use declare::{SettingInfo, Shown};
 pub use denoise::{denoise, denoise_available};
+#[cfg(feature = "clap")]
+#[cfg(feature = "clap")]
+pub use description::OutputFlags;
 pub use description::SceneDescription;
 pub use error::{Error, ErrorKind, Result};
 #[cfg(feature = "clap")]
-pub use flags::{OutputFlags, SceneFlags};
+pub use flags::{settings_table, SceneFlags};
 pub use output::{write_whole, Outputs};
-pub use overrides::Overrides;
+pub use overrides::{examples, settings, Overrides};
 pub use plan::VolumeCache;
 pub use prepare::{Placement, Prepared};
 pub use scene::Scene;

@@ -8,7 +8,6 @@ use cirrus_render::exr_layers::{write_exr_layers, Aov};
 use cirrus_render::image_io::write_png;
 use cirrus_render::{Crop, Rendered};
 
-use crate::defaults as d;
 use crate::description::SceneDescription;
 use crate::error::{Error, Result};
 
@@ -29,9 +28,9 @@ impl Outputs {
     pub fn resolve(desc: &SceneDescription) -> Outputs {
         let o = &desc.output;
         Outputs {
-            exr: o.exr.clone(),
+            exr: o.output.clone(),
             png: o.png.clone(),
-            exposure: o.exposure.unwrap_or(d::EXPOSURE),
+            exposure: o.exposure(),
             stats: o.stats.clone(),
             aovs: o.aov.clone().unwrap_or_default(),
             crop: o.crop.map(|[x0, y0, x1, y1]| Crop { x0, y0, x1, y1 }),

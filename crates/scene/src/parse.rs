@@ -1,7 +1,5 @@
 //! The text forms of values on command lines and in scene files.
 
-use cirrus_render::Crop;
-
 use crate::description::Colour;
 
 /// A colour: one finite number "x" (grey) or three "r,g,b".
@@ -28,7 +26,11 @@ pub fn triple(s: &str) -> Result<[f64; 3], String> {
     }
 }
 
-/// "WxH", each side 1 to 16384.
+/// Three finite numbers "x,y,z" as an `f32` vector (directions, colours).
+pub fn vector(s: &str) -> Result<[f32; 3], String> {
+    triple(s).map(|v| v.map(|c| c as f32))
+}
+
 /// A shutter `OPEN,CLOSE` in frames (`-0.25,0.25`), open <= close.
 pub fn shutter(s: &str) -> Result<[f32; 2], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
@@ -48,6 +50,7 @@ pub fn shutter(s: &str) -> Result<[f32; 2], String> {
     Ok([open, close])
 }
 
+/// "WxH", each side 1 to 16384.
 pub fn resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
@@ -62,14 +65,22 @@ pub fn resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+/// A resolution field of a scene file or a JSON dict: "WxH".
+pub fn resolution_field<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<(u32, u32)>, D::Error> {
+    let s = <String as serde::Deserialize>::deserialize(d)?;
+    resolution(&s).map(Some).map_err(serde::de::Error::custom)
+}
+
 /// "x0,y0,x1,y1" in pixels.
-pub fn crop(s: &str) -> Result<Crop, String> {
+pub fn crop(s: &str) -> Result<[u32; 4], String> {
     let v: Vec<u32> = s
         .split(',')
         .map(|c| c.trim().parse::<u32>().map_err(|e| format!("{s:?}: {e}")))
         .collect::<Result<_, _>>()?;
     match v[..] {
-        [x0, y0, x1, y1] => Ok(Crop { x0, y0, x1, y1 }),
+        [x0, y0, x1, y1] => Ok([x0, y0, x1, y1]),
         _ => Err(format!("expected x0,y0,x1,y1, got {s:?}")),
     }
 }
@@ -102,8 +113,7 @@ mod tests {
         assert!(resolution("0x4").is_err());
         assert!(resolution("16385x4").is_err());
         assert!(resolution("12by4").unwrap_err().contains("WxH"));
-        let c = crop("1,2,30,40").unwrap();
-        assert_eq!((c.x0, c.y0, c.x1, c.y1), (1, 2, 30, 40));
+        assert_eq!(crop("1,2,30,40").unwrap(), [1, 2, 30, 40]);
         assert!(crop("1,2,3").is_err());
     }
 }

@@ -17,7 +17,6 @@ use cirrus_render::{
 use cirrus_vdb::VolumeFile;
 use glam::{DMat3, DMat4, DVec3, Vec3};
 
-use crate::defaults as d;
 use crate::description::{Colour, ScaleSpec, VolumeSpec};
 use crate::error::{Error, Result};
 use crate::grids::{
@@ -126,7 +125,7 @@ pub fn plan(
         (0, None, None, None)
     } else {
         let f = files.open(&path)?;
-        let density = choose_grid(f, v.density.as_deref())?;
+        let density = choose_grid(f, v.grid.as_deref())?;
         let named = |n: &Option<String>| -> Result<Option<usize>> {
             n.as_ref()
                 .map(|n| f.find_grid(n).map_err(|e| Error::input(e.to_string())))
@@ -147,7 +146,7 @@ pub fn plan(
         (true, false) => choose_velocity(files.open(&path)?, v.velocity.as_deref())?,
         _ => None,
     };
-    let velocity_scale = v.velocity_scale.unwrap_or(d::VELOCITY_SCALE);
+    let velocity_scale = v.velocity_scale();
     if !velocity_scale.is_finite() {
         return Err(Error::input(format!(
             "{}: velocity scale must be finite, got {velocity_scale}",
@@ -163,14 +162,12 @@ pub fn plan(
         temperature,
         emission,
         velocity,
-        velocity_unit: v.velocity_unit.unwrap_or(d::VELOCITY_UNIT),
+        velocity_unit: v.velocity_unit(),
         velocity_scale,
         object_to_world,
         world_box,
         density_scale: v.density_scale,
-        albedo: v
-            .albedo
-            .map_or(Vec3::splat(d::ALBEDO), |a| Vec3::from_array(a.rgb())),
+        albedo: v.albedo().vec3(),
         phase: phase_of(v)?,
         blackbody: Blackbody {
             scale: bb.scale.unwrap_or(1.0),
@@ -184,17 +181,13 @@ pub fn plan(
 
 /// The phase function a volume names, with the defaults filled in.
 pub fn phase_of(v: &VolumeSpec) -> Result<Phase> {
-    let g = v.g.unwrap_or(d::G);
-    let name = v.phase.as_deref().unwrap_or("hg");
-    let phase = match name {
+    let g = v.g();
+    let name = v.phase();
+    let phase = match name.as_str() {
         "hg" => Ok(Phase::hg(g)),
-        "hg2" => Phase::hg2(
-            g,
-            v.g2.unwrap_or(d::G2),
-            v.lobe_weight.unwrap_or(d::LOBE_WEIGHT),
-        ),
-        "draine" => Phase::draine(g, v.draine_alpha.unwrap_or(d::DRAINE_ALPHA)),
-        "mie" => Phase::mie(v.droplet_diameter.unwrap_or(d::DROPLET_DIAMETER)),
+        "hg2" => Phase::hg2(g, v.g2(), v.lobe_weight()),
+        "draine" => Phase::draine(g, v.draine_alpha()),
+        "mie" => Phase::mie(v.droplet_diameter()),
         "rayleigh" => Ok(Phase::rayleigh()),
         _ => match name.strip_prefix("table:") {
             // The table's own errors name its file.
@@ -359,7 +352,7 @@ impl VolumeCache {
             )));
         }
         let density = moved(walk_cells(density, integrator, extinction.scale, refine))?;
-        let mut inst = Medium::new(density, extinction.scale, p.albedo, d::G)
+        let mut inst = Medium::new(density, extinction.scale, p.albedo, 0.0)
             .with_phase(p.phase.clone())
             .with_extinction_tint(extinction.tint);
         if p.emits() {
@@ -386,6 +379,10 @@ impl VolumeCache {
     }
 }
 
+/// A volume's default extinction per unit density is this over its voxel
+/// size: density 1 is half a mean free path per voxel.
+pub const DENSITY_SCALE_PER_VOXEL: f32 = 0.5;
+
 /// A volume's extinction per unit density: the given scale (one number or
 /// one per channel, each finite and >= 0), or the default for its voxel
 /// size; split for the renderer ([`Extinction`]).
@@ -395,7 +392,7 @@ pub(crate) fn extinction(
     voxel_size: f32,
 ) -> Result<Extinction> {
     let rgb = given.map_or(
-        Vec3::splat(d::DENSITY_SCALE_PER_VOXEL / voxel_size),
+        Vec3::splat(DENSITY_SCALE_PER_VOXEL / voxel_size),
         Colour::vec3,
     );
     if !rgb.is_finite() || rgb.min_element() < 0.0 {
@@ -436,7 +433,7 @@ mod tests {
         let rgb = extinction(f, Some(Colour::Rgb([10.0, 40.0, 20.0])), 0.1).unwrap();
         assert_eq!((rgb.scale, rgb.tint), (40.0, Vec3::new(0.25, 1.0, 0.5)));
         let default = extinction(f, None, 0.25).unwrap();
-        assert_eq!(default.scale, d::DENSITY_SCALE_PER_VOXEL / 0.25);
+        assert_eq!(default.scale, DENSITY_SCALE_PER_VOXEL / 0.25);
         for bad in [
             [1.0, -1.0, 1.0],
             [1.0, f32::NAN, 1.0],

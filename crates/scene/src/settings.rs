@@ -7,7 +7,6 @@ use std::sync::Arc;
 use cirrus_render::{Adaptive, Budget, EnvMap, Environment, Lights, RenderSettings, Shutter, Sun};
 use glam::{DVec3, Vec3};
 
-use crate::defaults as d;
 use crate::description::SceneDescription;
 use crate::error::{Error, Result};
 
@@ -29,7 +28,7 @@ impl SceneSettings {
     /// Resolves `desc` (the sky map, if any, is read here).
     pub fn resolve(desc: &SceneDescription) -> Result<SceneSettings> {
         let c = &desc.camera;
-        let look_at = match (c.from, c.to) {
+        let look_at = match (c.camera_from, c.camera_to) {
             (Some(f), Some(t)) => Some((DVec3::from_array(f), DVec3::from_array(t))),
             (None, None) => None,
             _ => {
@@ -45,24 +44,24 @@ impl SceneSettings {
             }
             (_, Some(t)) => Budget::Time(t),
             (Some(n), None) => Budget::Spp(n),
-            (None, None) => Budget::Spp(d::SPP),
+            (None, None) => Budget::Spp(r.spp()),
         };
         let render = RenderSettings {
-            integrator: r.integrator.unwrap_or(d::INTEGRATOR),
-            transmittance: r.transmittance.unwrap_or(d::TRANSMITTANCE),
-            majorant: r.majorant.unwrap_or(d::MAJORANT),
+            integrator: r.integrator(),
+            transmittance: r.transmittance(),
+            majorant: r.majorant(),
             budget,
-            seed: r.seed.unwrap_or(d::SEED),
-            sampler: r.sampler.unwrap_or(d::SAMPLER),
+            seed: r.seed(),
+            sampler: r.sampler(),
             adaptive: r.noise_threshold.map(|threshold| Adaptive {
                 threshold,
-                min_spp: r.min_spp.unwrap_or(d::MIN_SPP),
+                min_spp: r.min_spp(),
             }),
             max_depth: r.max_depth,
-            step_voxels: r.step.unwrap_or(d::STEP),
+            step_voxels: r.step(),
             shadow_step_voxels: r.shadow_step,
             shutter: {
-                let [open, close] = r.shutter.unwrap_or(d::SHUTTER);
+                let [open, close] = r.shutter();
                 Shutter::new(open, close)
             },
             progress: false,
@@ -70,14 +69,14 @@ impl SceneSettings {
         };
         render.validate()?;
         Ok(SceneSettings {
-            res: c.res.unwrap_or(d::RES),
+            res: c.res(),
             look_at,
-            camera_up: Vec3::from_array(c.up.unwrap_or(d::CAMERA_UP)),
-            fov: c.fov.unwrap_or(d::FOV),
+            camera_up: Vec3::from_array(c.camera_up()),
+            fov: c.fov(),
             lights: lights(desc)?,
             render,
-            refine_optical_depth: r.refine_optical_depth.unwrap_or(d::REFINE_OPTICAL_DEPTH),
-            denoise: r.denoise.unwrap_or(false),
+            refine_optical_depth: r.refine_optical_depth(),
+            denoise: r.denoise(),
         })
     }
 }
@@ -85,22 +84,19 @@ impl SceneSettings {
 /// The sun and sky of `desc`; absent or black lights pruned.
 fn lights(desc: &SceneDescription) -> Result<Lights> {
     let sun = desc.sun.clone().unwrap_or_default();
-    let sun = sun.enabled.unwrap_or(true).then(|| {
+    let sun = sun.sun().then(|| {
         Sun::new(
-            Vec3::from_array(sun.direction.unwrap_or(d::SUN_DIRECTION)),
-            Vec3::from_array(sun.irradiance.unwrap_or(d::SUN_IRRADIANCE)),
-            sun.angle.unwrap_or(d::SUN_ANGLE).to_radians(),
+            Vec3::from_array(sun.sun_dir()),
+            Vec3::from_array(sun.sun_irradiance()),
+            sun.sun_angle().to_radians(),
         )
     });
     let env = desc.environment.clone().unwrap_or_default();
-    let environment = match &env.map {
-        None => Environment::new(Vec3::from_array(env.radiance.unwrap_or(d::SKY_RADIANCE))),
+    let environment = match &env.env_map {
+        None => Environment::new(Vec3::from_array(env.env_radiance())),
         Some(path) => {
-            let map = EnvMap::read_exr(path, env.rotation.unwrap_or(d::SKY_ROTATION))?;
-            Environment::from_map(
-                Arc::new(map),
-                Vec3::splat(env.intensity.unwrap_or(d::SKY_INTENSITY)),
-            )
+            let map = EnvMap::read_exr(path, env.env_rotation())?;
+            Environment::from_map(Arc::new(map), Vec3::splat(env.env_intensity()))
         }
     };
     Ok(Lights {

@@ -16,11 +16,6 @@ pub struct RenderArgs {
     pub scene: SceneFlags,
     #[command(flatten)]
     pub output: OutputFlags,
-    /// Render frames A-B[:STEP]: the frame number replaces `####` or
-    /// `%04d` in every input and output path (the file, the scene's
-    /// volumes and sky, -o, --png, --stats).
-    #[arg(long)]
-    pub frames: Option<String>,
     /// Render frames whose EXR already exists (by default they are
     /// skipped, so an interrupted sequence resumes where it stopped).
     #[arg(long)]
@@ -44,7 +39,7 @@ pub fn run(args: &RenderArgs) -> CliResult {
 /// `--frames`, else a scene file's `[render] frames`, else none.
 fn frame_range(args: &RenderArgs) -> Result<Option<FrameRange>, Box<dyn std::error::Error>> {
     let file = &args.scene.file;
-    if let Some(s) = &args.frames {
+    if let Some(s) = &args.scene.render.frames {
         return Ok(Some(FrameRange::parse(s)?));
     }
     if has_pattern(&file.to_string_lossy()) {

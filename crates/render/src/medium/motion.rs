@@ -29,6 +29,15 @@ pub enum VelocityUnit {
     Voxels,
 }
 
+impl VelocityUnit {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::World => "world",
+            Self::Voxels => "voxels",
+        }
+    }
+}
+
 /// A velocity grid and how its values move a field.
 #[derive(Clone, Debug)]
 pub struct Velocity {

@@ -1,0 +1,172 @@
+//! Every setting is declared once (`description.rs`); these tests hold its
+//! forms to that declaration:
+//!
+//! - each setting with a flag has one, under its keyword, and the README's
+//!   table is the one made from the declaration (`CIRRUS_WRITE_README=1`
+//!   rewrites it);
+//! - each setting, given alone as an override (its declared example, in a
+//!   context where it matters), changes what the renderer is handed.
+
+use std::path::{Path, PathBuf};
+
+use cirrus_scene::{examples, settings, settings_table, Overrides, Scene, VolumeCache};
+
+const BEGIN: &str = "<!-- settings: made from crates/scene/src/description.rs -->\n";
+const END: &str = "<!-- end of settings -->";
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+#[test]
+fn the_readme_table_is_the_declaration() {
+    let table = settings_table();
+    assert!(
+        !table.contains("| ? |"),
+        "a setting without a flag:\n{table}"
+    );
+    let path = repo().join("README.md");
+    let readme = std::fs::read_to_string(&path).unwrap();
+    let start = readme.find(BEGIN).expect("README marks the settings table") + BEGIN.len();
+    let end = start + readme[start..].find(END).expect("the table's end mark");
+    if std::env::var_os("CIRRUS_WRITE_README").is_some() {
+        let written = format!("{}{table}{}", &readme[..start], &readme[end..]);
+        std::fs::write(&path, written).unwrap();
+        return;
+    }
+    assert_eq!(
+        readme[start..end],
+        table,
+        "README.md's settings table differs from the declaration; \
+         CIRRUS_WRITE_README=1 cargo test -p cirrus-scene --test settings rewrites it"
+    );
+}
+
+#[test]
+fn every_setting_with_a_flag_has_an_example() {
+    let declared: Vec<&str> = settings()
+        .iter()
+        .filter(|s| s.has_flag)
+        .map(|s| s.keyword)
+        .collect();
+    let examples: Vec<&str> = examples().iter().map(|(k, _)| *k).collect();
+    assert_eq!(declared, examples);
+    assert!(declared.len() >= 40, "{} settings", declared.len());
+}
+
+/// What a setting must be given with to matter at all.
+fn context(keyword: &str) -> Overrides {
+    let mut o = Overrides::default();
+    match keyword {
+        "min_spp" => o.noise_threshold = Some(0.05),
+        "step" | "shadow_step" => o.integrator = Some(cirrus_render::IntegratorKind::RayMarch),
+        "g2" | "lobe_weight" => o.phase = Some("hg2".into()),
+        "droplet_diameter" => o.phase = Some("mie".into()),
+        "draine_alpha" => o.phase = Some("draine".into()),
+        "velocity" => o.shutter = Some([-0.25, 0.25]),
+        "velocity_unit" | "velocity_scale" => {
+            o.shutter = Some([-0.25, 0.25]);
+            o.velocity = Some("velocity".into());
+        }
+        "env_rotation" | "env_intensity" => {
+            o.env_map = Some(repo().join("data/sky.exr"));
+        }
+        _ => {}
+    }
+    o
+}
+
+/// Everything the renderer is handed for `scene`, and the outputs: the
+/// render settings, camera, lights, each medium (its parameters, its
+/// field's bounds and majorant, its densities mid-shutter and the
+/// segments along one ray, which the majorant refinement changes), and
+/// the frame range a sequence renders.
+fn handed(scene: &Scene) -> String {
+    let mut cache = VolumeCache::default();
+    let p = match scene.prepare(&mut cache, None) {
+        Ok(p) => p,
+        Err(e) => return format!("error: {e}"),
+    };
+    let mut s = format!(
+        "{:?}\n{:?}\n{:?}\n{:?}\n{:?}\n",
+        p.settings,
+        p.scene.camera,
+        p.scene.lights,
+        scene.outputs(),
+        scene.description().render.frames
+    );
+    use cirrus_render::{DensityField, Media};
+    let b = p.scene.media.bounds();
+    let mid = 0.5 * (b.min + b.max);
+    // Mid-shutter densities on a 9^3 lattice over the bounds.
+    let lattice = (0..729).map(|i| {
+        let f = glam::Vec3::new((i % 9) as f32, ((i / 9) % 9) as f32, (i / 81) as f32) / 8.0;
+        b.min + (b.max - b.min) * f
+    });
+    let lattice: Vec<glam::Vec3> = lattice.collect();
+    for m in p.scene.media.instances() {
+        let moved: f32 = lattice.iter().map(|&q| m.field.density_at(q, 0.5)).sum();
+        let segments: usize = [glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z]
+            .into_iter()
+            .map(|axis| m.field.segments(mid, axis, 0.0, f32::INFINITY).count())
+            .sum();
+        s += &format!(
+            "{} {} {} {:?} {:?} {} {} {}\n",
+            m.density_scale,
+            m.extinction_tint,
+            m.albedo,
+            m.phase,
+            m.field.bounds(),
+            m.field.global_majorant(),
+            moved,
+            segments
+        );
+    }
+    s
+}
+
+/// A 6x4 image of `file` (in data/) from a fixed camera.
+fn base_scene(file: &str) -> Scene {
+    let data = repo().join("data");
+    let base = format!(
+        r#"
+        [camera]
+        res = "6x4"
+        from = [300.0, 60.0, 400.0]
+        to = [60.0, 40.0, 60.0]
+        [render]
+        spp = 2
+        [[volume]]
+        file = "{}"
+        "#,
+        data.join(file).display()
+    );
+    let description = cirrus_scene::SceneDescription::parse(&base).unwrap();
+    Scene::from_description(description, &data).unwrap()
+}
+
+#[test]
+fn every_setting_reaches_the_renderer() {
+    for (keyword, example) in examples() {
+        // The test files' velocity grids have 1-unit voxels, where world
+        // units and voxels are one unit; `crates/render/tests/motion_blur.rs`
+        // checks the voxel unit on a grid of 2-unit voxels.
+        if keyword == "velocity_unit" {
+            continue;
+        }
+        // A file with a velocity grid, or for the grid's choice one with
+        // two density-like grids.
+        let file = match keyword {
+            "grid" => "fireball.vdb",
+            _ => "multi_grid.vdb",
+        };
+        let mut before = base_scene(file);
+        before.apply(&context(keyword));
+        let mut after = before.clone();
+        after.apply(&example);
+        let (a, b) = (handed(&before), handed(&after));
+        assert!(!a.starts_with("error"), "{keyword}: the context fails: {a}");
+        assert!(!b.starts_with("error"), "{keyword}: the example fails: {b}");
+        assert_ne!(a, b, "{keyword} changes nothing the renderer is handed");
+    }
+}
