@@ -81,6 +81,10 @@ pub struct RenderSpec {
     /// `[open, close]` in frames around the frame (`--shutter`): motion
     /// blur from the volumes' velocity grids.
     pub shutter: Option<[f32; 2]>,
+    /// The frame a single render shows: where time-sampled values
+    /// (`transform.samples`, `[camera] samples`, `file_samples`) are read.
+    /// `--frames` sets it to each frame; default 0.
+    pub frame: Option<f64>,
 }
 
 /// `--res`, `--camera-from`, `--camera-to`, `--camera-up`, `--fov`.
@@ -94,6 +98,41 @@ pub struct CameraSpec {
     pub to: Option<[f64; 3]>,
     pub up: Option<[f32; 3]>,
     pub fov: Option<f32>,
+    /// Camera to world, a 4x4 matrix (rows; column vectors, the translation
+    /// in the last column): the camera looks along its -Z axis with +Y up,
+    /// as in USD and Blender. Exclusive with `from`/`to`.
+    pub matrix: Option<Matrix>,
+    /// Time-sampled camera-to-world matrices (frames), interpolated between
+    /// samples: motion blur when the shutter is open.
+    pub samples: Option<Vec<MatrixSample>>,
+    /// Focal length and apertures (any one unit, USD's tenths of a scene
+    /// unit or millimetres): the field of view, instead of `fov`. The
+    /// aperture is expanded to the image's aspect (USD's `expandAperture`).
+    pub focal_length: Option<f32>,
+    pub horizontal_aperture: Option<f32>,
+    pub vertical_aperture: Option<f32>,
+    /// `[near, far]` distances along the view axis: nothing nearer than
+    /// `near` is seen (far is recorded and warned about, not clipped).
+    pub clipping: Option<[f32; 2]>,
+}
+
+/// A 4x4 matrix as rows (column vectors: the translation is the last column).
+pub type Matrix = [[f64; 4]; 4];
+
+/// A matrix at a time in frames.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MatrixSample {
+    pub time: f64,
+    pub matrix: Matrix,
+}
+
+/// A volume file from a time on (held until the next sample).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FileSample {
+    pub time: f64,
+    pub file: PathBuf,
 }
 
 /// `--sun-dir`, `--sun-irradiance`, `--sun-angle`, `--no-sun`.
@@ -196,6 +235,9 @@ pub struct VolumeSpec {
     pub blackbody: BlackbodySpec,
     pub emission_color: Option<[f32; 3]>,
     pub emission_scale: Option<f32>,
+    /// Time-sampled files (frames): the frame rendered reads the sample
+    /// held at its time (the last at or before it, else the first).
+    pub file_samples: Option<Vec<FileSample>>,
 }
 
 /// Object to world: scale, then rotate, then translate.
@@ -210,6 +252,13 @@ pub struct TransformSpec {
     pub euler: Option<[f64; 3]>,
     /// Uniform (a number) or per axis.
     pub scale: Option<ScaleSpec>,
+    /// Object to world as a 4x4 matrix (rows, column vectors), exclusive
+    /// with the fields above.
+    pub matrix: Option<Matrix>,
+    /// Time-sampled object-to-world matrices (frames), interpolated between
+    /// samples (translation and scale linearly, rotation by slerp): motion
+    /// blur when the shutter is open. Exclusive with the fields above.
+    pub samples: Option<Vec<MatrixSample>>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -272,6 +321,9 @@ impl SceneDescription {
     pub fn rebase(&mut self, dir: &Path) {
         for v in &mut self.volumes {
             v.file = dir.join(&v.file);
+            for s in v.file_samples.iter_mut().flatten() {
+                s.file = dir.join(&s.file);
+            }
             if let Some(table) = v.phase.as_deref().and_then(|p| p.strip_prefix("table:")) {
                 v.phase = Some(format!("table:{}", dir.join(table).display()));
             }
@@ -284,9 +336,14 @@ impl SceneDescription {
     /// Every input and output path with its frame pattern replaced by `frame`.
     pub fn substitute_frame(&mut self, frame: i64) {
         use crate::frames::substitute;
+        self.render.frame = Some(frame as f64);
         for v in &mut self.volumes {
             v.file = substitute(&v.file, frame);
+            for s in v.file_samples.iter_mut().flatten() {
+                s.file = substitute(&s.file, frame);
+            }
         }
+        crate::timeline::hold_file_samples(self);
         if let Some(map) = self.environment.as_mut().and_then(|e| e.map.as_mut()) {
             *map = substitute(map, frame);
         }
@@ -296,7 +353,7 @@ impl SceneDescription {
         }
     }
 
-    /// What serde cannot say: exclusive fields.
+    /// What serde cannot say: exclusive fields, ordered samples.
     fn check(&self) -> std::result::Result<(), String> {
         for (i, v) in self.volumes.iter().enumerate() {
             if v.transform.rotate.is_some() && v.transform.euler.is_some() {
@@ -306,8 +363,10 @@ impl SceneDescription {
                     v.file.display()
                 ));
             }
+            crate::timeline::check_volume(v)
+                .map_err(|e| format!("volume {} ({}): {e}", i + 1, v.file.display()))?;
         }
-        Ok(())
+        crate::timeline::check_camera(&self.camera).map_err(|e| format!("[camera] {e}"))
     }
 }
 

@@ -43,12 +43,15 @@ mod flags;
 pub mod frames;
 pub mod grids;
 pub mod info;
+mod moving;
 mod output;
 mod overrides;
 pub mod parse;
 mod plan;
 mod scene;
 mod settings;
+pub mod timeline;
+pub mod usd;
 
 pub use denoise::{denoise, denoise_available};
 pub use description::SceneDescription;

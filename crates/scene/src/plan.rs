@@ -33,7 +33,7 @@ pub struct Plan {
     velocity: Option<usize>,
     velocity_unit: VelocityUnit,
     velocity_scale: f32,
-    object_to_world: DMat4,
+    pub(crate) object_to_world: DMat4,
     /// From the grid header, when the file says.
     pub world_box: Option<DBounds3>,
     density_scale: Option<Colour>,
@@ -51,6 +51,9 @@ impl Plan {
 
 fn object_to_world(v: &VolumeSpec) -> DMat4 {
     let t = &v.transform;
+    if let Some(m) = &t.matrix {
+        return crate::timeline::to_dmat4(m);
+    }
     let translate = DMat4::from_translation(DVec3::from_array(t.translate.unwrap_or([0.0; 3])));
     let rotate = match (&t.rotate, t.euler) {
         (Some(r), _) => {
@@ -224,6 +227,11 @@ impl Files {
         Ok(&self.grids[&key])
     }
 
+    /// A plan's loaded density grid.
+    pub(crate) fn density_volume(&self, p: &Plan) -> &BrickVolume {
+        &self.grids[&(p.file.clone(), p.density)]
+    }
+
     /// The world box of a plan's density grid, loading it.
     pub fn density_box(&mut self, p: &Plan) -> Result<DBounds3> {
         let v = self.grid(&p.file, p.cbrk, p.density)?;
@@ -329,6 +337,36 @@ impl Files {
             });
         }
         Ok(inst)
+    }
+
+    /// The field whose segments bound a moving plan's density over every
+    /// pose: its `shell` placed as the plan is, walked as its density is.
+    pub(crate) fn bound_field<'v>(
+        &'v self,
+        p: &Plan,
+        shell: &'v BrickVolume,
+        centre: DVec3,
+        settings: &crate::settings::SceneSettings,
+        shutter: Shutter,
+    ) -> Result<BrickField<'v>> {
+        let field = BrickField::new(shell, p.object_to_world, centre);
+        let extinction = extinction(&p.file, p.density_scale, field.voxel_size())?;
+        let field = walk_cells(
+            field,
+            settings.render.integrator,
+            extinction.scale,
+            settings.refine_optical_depth,
+        );
+        let velocity = self.velocity_of(p);
+        moved(field, velocity.as_ref(), shutter, &p.file)
+    }
+
+    fn velocity_of(&self, p: &Plan) -> Option<Velocity> {
+        p.velocity.map(|index| Velocity {
+            grid: self.velocities[&(p.file.clone(), index)].clone(),
+            unit: p.velocity_unit,
+            scale: p.velocity_scale,
+        })
     }
 
     pub fn bytes_read(&self) -> u64 {

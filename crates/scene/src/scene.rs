@@ -47,12 +47,24 @@ pub struct Scene {
     lone: bool,
     /// Draw a progress bar on a terminal's stderr while rendering.
     pub progress_bar: bool,
+    /// What the scene's reader could not render (a USD stage's meshes...).
+    warnings: Vec<String>,
 }
 
 impl Scene {
-    /// A scene file (`.toml`), or a lone `.vdb`, `.nvdb` or `.cbrk` volume.
+    /// A scene file (`.toml`), a USD stage (`.usd`, `.usda`, `.usdc`,
+    /// `.usdz`; `usd/`), or a lone `.vdb`, `.nvdb` or `.cbrk` volume.
     pub fn load(path: &Path) -> Result<Scene> {
-        if path.extension().is_some_and(|e| e == "toml") {
+        if crate::usd::is_usd(path) {
+            let stage = crate::usd::read(path)?;
+            let mut scene =
+                Scene::from_description(stage.description, parent(path)).map_err(|e| Error {
+                    message: format!("{}: {}", path.display(), e.message),
+                    ..e
+                })?;
+            scene.warnings = stage.warnings;
+            Ok(scene)
+        } else if path.extension().is_some_and(|e| e == "toml") {
             let description = SceneDescription::read(path)?;
             Scene::from_description(description, parent(path)).map_err(|e| Error {
                 message: format!("{}: {}", path.display(), e.message),
@@ -75,6 +87,7 @@ impl Scene {
             },
             lone: true,
             progress_bar: false,
+            warnings: Vec::new(),
         }
     }
 
@@ -84,11 +97,18 @@ impl Scene {
             return Err(Error::input("no [[volume]] in the scene"));
         }
         description.rebase(dir);
+        crate::timeline::hold_file_samples(&mut description);
         Ok(Scene {
             description,
             lone: false,
             progress_bar: false,
+            warnings: Vec::new(),
         })
+    }
+
+    /// What the reader could not render (listed, never fatal).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     pub fn description(&self) -> &SceneDescription {
@@ -317,6 +337,14 @@ fn render_file(
     let mut files = Files::default();
     let shutter = settings.render.shutter;
     let moving = shutter.max_abs_time() > 0.0;
+    // Time-sampled transforms read at the frame, and over the shutter.
+    let frame = crate::timeline::frame_of(desc);
+    let tracks: Vec<_> = desc
+        .volumes
+        .iter()
+        .map(|v| crate::moving::track(v, frame, [shutter.open, shutter.close]))
+        .collect();
+    let desc = &crate::timeline::at_frame(desc);
     let plans = desc
         .volumes
         .iter()
@@ -332,7 +360,10 @@ fn render_file(
     let union = boxes.iter().fold(DBounds3::EMPTY, |u, &b| u.union(b));
     // Render space: world minus the scene's centre, in f64.
     let centre = union.centre();
-    let camera = camera(settings, centre, union.relative_to(centre));
+    let camera = match crate::moving::camera(desc, settings, centre)? {
+        Some(c) => c,
+        None => camera(settings, centre, union.relative_to(centre)),
+    };
     let (w, h) = settings.res;
     let window = settings.render.crop.unwrap_or(Crop {
         x0: 0,
@@ -345,11 +376,16 @@ fn render_file(
     let boxes: Vec<DBounds3> = plans
         .iter()
         .zip(boxes)
-        .map(|(p, b)| files.motion_box(p, b, shutter))
+        .zip(&tracks)
+        .map(|((p, b), t)| {
+            let b = t.as_ref().map_or(b, |t| t.swept(b));
+            files.motion_box(p, b, shutter)
+        })
         .collect::<Result<_>>()?;
+    // A moving camera sees more than its frame's frustum.
     let visible: Vec<bool> = boxes
         .iter()
-        .map(|b| in_frustum(&camera, window, b.relative_to(centre)))
+        .map(|b| camera.moves() || in_frustum(&camera, window, b.relative_to(centre)))
         .collect();
     let any_emission = plans.iter().any(|p| p.emits());
     let keep = needed(
@@ -361,19 +397,49 @@ fn render_file(
     );
 
     // Read what is needed, then place it.
-    let kept = || plans.iter().zip(&keep).filter(|(_, k)| **k).map(|(p, _)| p);
-    for p in kept() {
+    let kept = || {
+        plans
+            .iter()
+            .zip(&tracks)
+            .zip(&keep)
+            .filter(|(_, k)| **k)
+            .map(|(p, _)| p)
+    };
+    for (p, _) in kept() {
         files.load_grids(p)?;
     }
+    // Moving volumes' pose tables and the shells bounding their poses.
+    let tables = kept()
+        .map(|(_, t)| t.as_ref().map(|t| t.table(centre)).transpose())
+        .collect::<Result<Vec<_>>>()?;
+    let shells = kept()
+        .zip(&tables)
+        .map(|((p, _), table)| match table {
+            Some(table) => {
+                crate::moving::shell(files.density_volume(p), p.object_to_world, centre, table)
+                    .map(Some)
+            }
+            None => Ok(None),
+        })
+        .collect::<Result<Vec<_>>>()?;
     let instances = kept()
-        .map(|p| {
-            files.instance(
+        .zip(tables.into_iter().zip(&shells))
+        .map(|((p, _), (table, shell))| {
+            let instance = files.instance(
                 p,
                 centre,
                 settings.render.integrator,
                 settings.refine_optical_depth,
                 shutter,
-            )
+            )?;
+            let motion = match (table, shell) {
+                (Some(table), Some(shell)) => {
+                    let bound = files.bound_field(p, shell, centre, settings, shutter)?;
+                    Some((table, bound))
+                }
+                _ => None,
+            };
+            Ok(crate::moving::wrap(instance, motion))
         })
         .collect::<Result<Vec<_>>>()?;
     let volumes = Volumes::new(instances);
