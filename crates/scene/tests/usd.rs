@@ -205,12 +205,25 @@ def Volume "Cloud"
     uniform token[] xformOpOrder = ["xformOp:translate"]
     def OpenVDBAsset "density"
     {
-        asset filePath.timeSamples = { 1: @./cloud.vdb@, 2: @./cloud2.vdb@ }
+        asset filePath = @./cloud.vdb@
         token fieldName = "density"
     }
 }
 "#;
-    let p = write(&d, "shot.usda", text);
+    // The per-frame filePath, authored through openusd into a binary
+    // crate (its text parser takes no asset values in timeSamples).
+    let usda = write(&d, "base.usda", text);
+    let stage = openusd::usd::Stage::open(usda.to_str().unwrap()).unwrap();
+    let file_path = stage.attribute("/Cloud/density.filePath");
+    for (t, f) in [(1.0, "./cloud.vdb"), (2.0, "./cloud2.vdb")] {
+        let value = openusd::sdf::Value::AssetPath(openusd::sdf::AssetPath::new(f));
+        file_path
+            .clone()
+            .set_at(value, openusd::usd::TimeCode::new(t))
+            .unwrap();
+    }
+    let p = d.join("shot.usdc");
+    stage.root_layer().export(p.to_str().unwrap()).unwrap();
     let scene = Scene::load(&p).unwrap();
     let desc = scene.description();
     assert_eq!(desc.render.frames.as_deref(), Some("1-3"));
@@ -236,6 +249,17 @@ def Volume "Cloud"
         ]
     );
     assert!(scene.warnings().join("\n").contains("no volume material"));
+    // The same samples in a text layer: refused with a hint.
+    let sampled = text.replace(
+        "asset filePath = @./cloud.vdb@",
+        "asset filePath.timeSamples = { 1: @./cloud.vdb@, 2: @./cloud2.vdb@ }",
+    );
+    let e = Scene::load(&write(&d, "text.usda", &sampled)).unwrap_err();
+    assert!(
+        e.message.contains("text.usda") && e.message.contains(".usdc"),
+        "{}",
+        e.message
+    );
 }
 
 /// 200 stages, text and binary, with bytes flipped, overwritten or cut:
@@ -289,6 +313,7 @@ fn mutated_stages_fail_cleanly_or_render() {
             }
         }
     }
+    eprintln!("200 mutated stages: {loaded} rendered, {refused} refused");
     assert_eq!(loaded + refused, 200);
     assert!(
         refused > 0 && loaded > 0,

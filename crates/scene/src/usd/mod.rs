@@ -22,9 +22,12 @@
 //!
 //! Every other prim (meshes, other lights, ...) is listed once in a
 //! warning with its path and type: never fatal, never silently dropped.
-//! The `openusd` reader is guarded: a panic inside it becomes an error.
+//! The `openusd` reader is guarded: a stage is read first in a child
+//! process (`isolate.rs`), so one that crashes or hangs it is an error
+//! naming the file, and a panic inside it becomes an error too.
 
 mod camera;
+mod isolate;
 mod lights;
 pub mod material;
 mod values;
@@ -92,6 +95,10 @@ pub fn read(path: &Path) -> Result<StageScene> {
     let text = path
         .to_str()
         .ok_or_else(|| Error::file(format!("{file}: the path is not UTF-8")))?;
+    // First in a child process (`isolate.rs`): a file that crashes or hangs
+    // the reader fails here, naming it.
+    isolate::trial(|| read_guarded(text, &file).map(drop).map_err(|e| e.message))
+        .map_err(|why| Error::input(format!("{file}: {why}")))?;
     match catch_unwind(AssertUnwindSafe(|| read_guarded(text, &file))) {
         Ok(result) => result,
         Err(panic) => {
@@ -108,7 +115,15 @@ pub fn read(path: &Path) -> Result<StageScene> {
 }
 
 fn read_guarded(text: &str, file: &str) -> Result<StageScene> {
-    let stage = Stage::open(text).map_err(|e| Error::input(format!("{file}: {e:#}")))?;
+    let stage = Stage::open(text).map_err(|e| {
+        let e = format!("{e:#}");
+        // openusd 0.6's text parser takes no asset values in timeSamples.
+        let hint = match e.contains("AssetRef") {
+            true => " (time-sampled asset paths, such as a per-frame filePath, are read from .usdc layers, not .usda)",
+            false => "",
+        };
+        Error::input(format!("{file}: {e}{hint}"))
+    })?;
     let time = Time {
         start: stage.start_time_code(),
         end: stage.end_time_code(),

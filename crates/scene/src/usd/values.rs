@@ -84,17 +84,39 @@ fn not_a(prim: &Prim, name: &str, what: &str, v: &Value) -> Error {
 }
 
 /// An asset attribute at `time`: `(authored, resolved)`; `resolved` is
-/// `None` when the path names no file the resolver found.
+/// `None` when the path names no file that exists.
 pub fn attr_asset(prim: &Prim, name: &str, time: f64) -> Result<Option<(String, Option<String>)>> {
-    Ok(match value(prim, name, time)? {
-        Some(Value::AssetPath(a)) => Some((
+    let (authored, resolved) = match value(prim, name, time)? {
+        Some(Value::AssetPath(a)) => (
             a.authored_path.clone(),
             a.resolved_path()
                 .filter(|p| !p.is_empty())
                 .map(str::to_string),
-        )),
-        Some(Value::String(s)) => Some((s.clone(), None)),
-        _ => None,
+        ),
+        Some(Value::String(s)) => (s, None),
+        _ => return Ok(None),
+    };
+    let resolved = match resolved {
+        Some(r) => Some(r),
+        None => anchored(&prim.attribute(name), &authored),
+    };
+    Ok(Some((authored, resolved)))
+}
+
+/// `authored` anchored to the layers that author `attr`, strongest first,
+/// where the file exists: value resolution leaves time-sampled asset
+/// values of openusd 0.6 unresolved.
+fn anchored(attr: &Attribute, authored: &str) -> Option<String> {
+    let path = std::path::Path::new(authored);
+    if path.is_absolute() {
+        return path.exists().then(|| authored.to_string());
+    }
+    let stack = attr.property_stack().ok()?;
+    stack.iter().find_map(|(layer, _)| {
+        let candidate = std::path::Path::new(layer).parent()?.join(path);
+        candidate
+            .exists()
+            .then(|| candidate.to_string_lossy().into_owned())
     })
 }
 
