@@ -30,7 +30,8 @@ def compatible_panels():
     names = ("RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_output", "RENDER_PT_motion_blur",
              "DATA_PT_camera", "DATA_PT_lens", "DATA_PT_camera_display", "DATA_PT_light",
              "DATA_PT_volume_file", "DATA_PT_volume_grids", "EEVEE_LIGHT_PT_light")
-    return [getattr(bpy.types, n) for n in names if hasattr(bpy.types, n)]
+    panels = (getattr(bpy.types, n, None) for n in names)
+    return [p for p in panels if p is not None and isinstance(getattr(p, "COMPAT_ENGINES", None), set)]
 
 
 class CirrusRenderEngine(bpy.types.RenderEngine):

@@ -168,11 +168,12 @@ def test_a_stage_with_a_mesh_renders_with_a_warning_naming_it(tmp_path):
 
 def author_frames(d: Path) -> Path:
     """Three frames: the camera moves along x (time-sampled), the volume
-    file is the cloud on frames 1 and 3 and a fog sphere on frame 2."""
+    file is the cloud on frames 1 and 3 and a fog sphere on frame 2. A
+    binary crate: openusd 0.6 reads time-sampled asset paths only there."""
     d.mkdir(parents=True, exist_ok=True)
     shutil.copy(us.CLOUD, d / "cloud.vdb")
     shutil.copy(us.REPO / "data" / "sphere_fog.vdb", d / "sphere.vdb")
-    stage = us.new_stage(d / "frames.usda", start=1, end=3)
+    stage = us.new_stage(d / "frames.usdc", start=1, end=3)
     vol = us.cloud_volume(stage, "/Cloud", "./cloud.vdb", us.material(stage))
     path = vol.GetPrim().GetPrimAtPath("density").GetAttribute("filePath")
     for t, f in ((1, "./cloud.vdb"), (2, "./sphere.vdb"), (3, "./cloud.vdb")):
@@ -186,7 +187,7 @@ def author_frames(d: Path) -> Path:
     dome.CreateIntensityAttr(1.0)
     us.render_settings(stage, res=(24, 24))
     stage.GetRootLayer().Save()
-    return d / "frames.usda"
+    return d / "frames.usdc"
 
 
 def frame_twin(d: Path, t: int) -> dict:
@@ -206,9 +207,9 @@ def frame_twin(d: Path, t: int) -> dict:
 def read_exr(path: Path) -> np.ndarray:
     import OpenEXR
 
-    with OpenEXR.File(str(path)) as f:
-        ch = f.channels()
-        return np.stack([ch[c].pixels for c in "RGBA"], axis=-1)
+    with OpenEXR.File(str(path), separate_channels=True) as f:
+        ch = {name: np.asarray(c.pixels) for name, c in f.channels().items()}
+    return np.stack([ch[c] for c in "RGBA"], axis=-1)
 
 
 def test_a_three_frame_stage_renders_its_own_range_with_its_files_and_camera(tmp_path):
