@@ -236,7 +236,7 @@ class Export:
         self.desc["environment"] = env
         if world is None:
             return
-        if not world.use_nodes:
+        if world.node_tree is None:
             env["radiance"] = [float(c) for c in world.color]
             return
         out = next((n for n in world.node_tree.nodes
@@ -302,7 +302,7 @@ def coefficients(scatter: list[float], absorb: list[float]) -> dict:
 
 def volume_node(mat):
     """The node feeding the active material output's Volume input."""
-    if mat is None or not mat.use_nodes:
+    if mat is None or mat.node_tree is None:
         return None
     outs = [n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
     out = next((n for n in outs if n.is_active_output and n.target in ("ALL", "CYCLES")), None)

@@ -26,7 +26,7 @@ fn vec3(s: &str) -> Result<Vec3, String> {
 /// What to render and how: every flag but the outputs.
 #[derive(clap::Args, Clone, Debug)]
 pub struct SceneFlags {
-    /// A .vdb, .nvdb or .cbrk file, or a scene file (.toml).
+    /// A .vdb, .nvdb or .cbrk file, a scene file (.toml) or a USD stage (.usd, .usda, .usdc, .usdz).
     pub file: PathBuf,
     /// The density grid [default: "density", else the first float grid].
     #[arg(long)]

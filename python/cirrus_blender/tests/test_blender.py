@@ -22,6 +22,7 @@ import pytest  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[3]
 ADDON = REPO / "python" / "cirrus_blender"
+MODULE = "bl_ext.user_default.cirrus"
 CLOUD = REPO / "data" / "cloud.vdb"
 RES = 64
 ALBEDO, DENSITY_PER_VOXEL, G = 0.8, 0.5, 0.4
@@ -44,8 +45,7 @@ def addon(tmp_path_factory):
     result = bpy.ops.extensions.package_install_files(
         filepath=str(zip_path), repo="user_default", enable_on_install=True)
     assert result == {"FINISHED"}
-    module = sys.modules["bl_ext.user_default.cirrus"]
-    return module
+    return sys.modules[MODULE]
 
 
 def voxel_size(vol) -> float:
@@ -64,6 +64,8 @@ def build_scene(extra_mesh: bool = False):
     """The corpus cloud as a volume object under a sun, a world colour and
     a camera; its Principled Volume is grey, albedo ALBEDO."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
+    # Factory settings disable add-ons; the installed extension stays.
+    bpy.ops.preferences.addon_enable(module=MODULE)
     scene = bpy.context.scene
     vol = bpy.data.volumes.new("cloud")
     vol.filepath = str(CLOUD)
@@ -85,8 +87,11 @@ def build_scene(extra_mesh: bool = False):
     nt.links.new(pv.outputs["Volume"], out.inputs["Volume"])
     vol.materials.append(mat)
     # Camera and sun around the cloud's box (Blender is Z-up).
+    import mathutils
+
     bpy.context.view_layer.update()
-    corners = [obj.matrix_world @ __import__("mathutils").Vector(c) for c in obj.bound_box]
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    corners = [obj.matrix_world @ mathutils.Vector(c) for c in evaluated.bound_box]
     lo = [min(c[i] for c in corners) for i in range(3)]
     hi = [max(c[i] for c in corners) for i in range(3)]
     centre = [(a + b) / 2 for a, b in zip(lo, hi)]
@@ -97,7 +102,7 @@ def build_scene(extra_mesh: bool = False):
     cam_data.clip_start = 1e-3
     cam_data.clip_end = 1e7
     cam = bpy.data.objects.new("Cam", cam_data)
-    eye = (centre[0] + 0.3 * size, centre[1] - 1.6 * size, centre[2] + 0.4 * size)
+    eye = (centre[0] + 0.2 * size, centre[1] - 1.05 * size, centre[2] + 0.3 * size)
     cam.matrix_world = look_at(eye, centre)
     scene.collection.objects.link(cam)
     scene.camera = cam
