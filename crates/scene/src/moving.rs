@@ -18,6 +18,7 @@ use glam::{DMat4, DVec3, Vec3};
 
 use crate::description::{SceneDescription, VolumeSpec};
 use crate::error::{Error, Result};
+use crate::plan::{Files, Plan};
 use crate::settings::SceneSettings;
 use crate::timeline::{camera_placement, frame_of, lens_fov, matrix_at};
 
@@ -98,6 +99,49 @@ pub fn shell(
     volume
         .motion_shell(reach)
         .map_err(|e| Error::input(format!("moving volume: {e}")))
+}
+
+/// Per kept plan, the pose table and shell of the moving ones (their
+/// grids loaded).
+pub fn poses<'a>(
+    files: &Files,
+    kept: impl Iterator<Item = (&'a Plan, &'a Option<Track>)>,
+    centre: DVec3,
+) -> Result<Vec<Option<(Arc<PoseTable>, BrickVolume)>>> {
+    kept.map(|(p, track)| {
+        let Some(track) = track else { return Ok(None) };
+        let table = track.table(centre)?;
+        let shell = shell(files.density_volume(p), p.object_to_world, centre, &table)?;
+        Ok(Some((table, shell)))
+    })
+    .collect()
+}
+
+/// The instance of a plan whose grids are loaded, moving through `pose`
+/// (its table and shell) when it has one.
+pub fn instance<'v>(
+    files: &'v Files,
+    p: &Plan,
+    pose: Option<&'v (Arc<PoseTable>, BrickVolume)>,
+    centre: DVec3,
+    settings: &SceneSettings,
+) -> Result<VolumeInstance<MovingField<BrickField<'v>>>> {
+    let s = &settings.render;
+    let inst = files.instance(
+        p,
+        centre,
+        s.integrator,
+        settings.refine_optical_depth,
+        s.shutter,
+    )?;
+    let motion = match pose {
+        Some((table, shell)) => {
+            let bound = files.bound_field(p, shell, centre, settings, s.shutter)?;
+            Some((table.clone(), bound))
+        }
+        None => None,
+    };
+    Ok(wrap(inst, motion))
 }
 
 /// `inst`'s fields wrapped: still, or moving through `table` with the

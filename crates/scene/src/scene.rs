@@ -409,38 +409,10 @@ fn render_file(
         files.load_grids(p)?;
     }
     // Moving volumes' pose tables and the shells bounding their poses.
-    let tables = kept()
-        .map(|(_, t)| t.as_ref().map(|t| t.table(centre)).transpose())
-        .collect::<Result<Vec<_>>>()?;
-    let shells = kept()
-        .zip(&tables)
-        .map(|((p, _), table)| match table {
-            Some(table) => {
-                crate::moving::shell(files.density_volume(p), p.object_to_world, centre, table)
-                    .map(Some)
-            }
-            None => Ok(None),
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let poses = crate::moving::poses(&files, kept(), centre)?;
     let instances = kept()
-        .zip(tables.into_iter().zip(&shells))
-        .map(|((p, _), (table, shell))| {
-            let instance = files.instance(
-                p,
-                centre,
-                settings.render.integrator,
-                settings.refine_optical_depth,
-                shutter,
-            )?;
-            let motion = match (table, shell) {
-                (Some(table), Some(shell)) => {
-                    let bound = files.bound_field(p, shell, centre, settings, shutter)?;
-                    Some((table, bound))
-                }
-                _ => None,
-            };
-            Ok(crate::moving::wrap(instance, motion))
-        })
+        .zip(&poses)
+        .map(|((p, _), pose)| crate::moving::instance(&files, p, pose.as_ref(), centre, settings))
         .collect::<Result<Vec<_>>>()?;
     let volumes = Volumes::new(instances);
     if volumes.instances().is_empty() {
