@@ -122,10 +122,16 @@ def test_a_composed_shot_renders_as_its_toml_twin_bit_for_bit(tmp_path):
     twin = render(shot_twin(tmp_path))
     assert usd[..., 3].mean() > 0.05, "the clouds are in view"
     assert np.array_equal(usd, twin)
-    # The same stage as a binary crate and as a package reads the same.
+    # The same stage as a binary crate, and packaged with its layers, VDB
+    # and sky by usd-core into a .usdz, reads the same.
     layer = Sdf.Layer.FindOrOpen(str(shot))
     layer.Export(str(tmp_path / "shot.usdc"))
     assert np.array_equal(render(tmp_path / "shot.usdc"), usd)
+    from pxr import UsdUtils
+
+    assert UsdUtils.CreateNewUsdzPackage(Sdf.AssetPath(str(shot)), str(tmp_path / "shot.usdz"))
+    (tmp_path / "cloud.vdb").unlink()  # the package's own copy is read
+    assert np.array_equal(render(tmp_path / "shot.usdz"), usd)
 
 
 def block_z(a1, a2, b1, b2, blocks=4) -> np.ndarray:

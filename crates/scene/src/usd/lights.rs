@@ -121,8 +121,10 @@ pub fn dome(r: &mut Reader, path: &str) -> Result<EnvironmentSpec> {
             "{path}: a coloured dome tints a texture: only its mean is applied"
         ));
     }
+    let map = super::package::extracted(&map)
+        .map_err(|e| Error::file(format!("{}: {path}: {e}", r.file)))?;
     Ok(EnvironmentSpec {
-        map: Some(map.into()),
+        map: Some(map),
         intensity: Some((radiance.x + radiance.y + radiance.z) / 3.0),
         rotation: Some(rotation),
         ..Default::default()

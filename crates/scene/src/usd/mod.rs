@@ -22,7 +22,8 @@
 //!
 //! Every other prim (meshes, other lights, ...) is listed once in a
 //! warning with its path and type: never fatal, never silently dropped.
-//! The `openusd` reader is guarded: a stage is read first in a child
+//! VDBs and sky maps packaged inside a `.usdz` are copied out to the
+//! temporary directory once (`package.rs`). The `openusd` reader is guarded: a stage is read first in a child
 //! process (`isolate.rs`), so one that crashes or hangs it is an error
 //! naming the file, and a panic inside it becomes an error too.
 
@@ -30,6 +31,7 @@ mod camera;
 mod isolate;
 mod lights;
 pub mod material;
+mod package;
 mod values;
 mod volume;
 mod xform;

@@ -143,11 +143,8 @@ fn field(r: &mut Reader, volume: &str, relationship: String, prim_path: String) 
                 "{}: {prim_path}: filePath @{authored}@ (field:{relationship} of {volume}) names no file that exists",
                 r.file
             ))),
-            Some((authored, Some(p))) if p.ends_with(']') => Err(r.error(
-                &prim_path,
-                format!("filePath @{authored}@ is inside a package ({p}): keep the VDB beside the .usdz"),
-            )),
-            Some((_, Some(p))) => Ok(PathBuf::from(p)),
+            Some((_, Some(p))) => super::package::extracted(&p)
+                .map_err(|e| Error::file(format!("{}: {prim_path}: {e}", r.file))),
         }
     };
     let times = sample_times(&prim.attribute("filePath"))?;
