@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Every test of the project, as CI runs them: the Rust workspace (the
 # denoiser's tests with the real Open Image Denoise library from PyPI's
-# pyoidn), the Python module, the Dask farm driver, and `cirrus preview`
-# in headless Chromium.
+# pyoidn), the Python module (with Pixar's usd-core for the USD stages),
+# the Dask farm driver, `cirrus preview` in headless Chromium, and the
+# Blender add-on under PyPI's bpy (CPython 3.13, tools/python313.sh).
 # Needs: cargo, python3 (3.11+) with venv and pip, and the package indexes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,3 +15,4 @@ cargo test --workspace --release
 bash tools/test_python.sh "$python"
 bash tools/test_farm.sh target/venv/bin/python
 bash tools/browser_test.sh
+bash tools/test_blender.sh

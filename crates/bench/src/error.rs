@@ -248,7 +248,7 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
             .into_instances()
             .into_iter()
             .map(|m| Medium {
-                field: FixedGridField::new(m.field, args.fixed_res),
+                field: FixedGridField::new(m.field.into_still(), args.fixed_res),
                 density_scale: m.density_scale,
                 extinction_tint: m.extinction_tint,
                 albedo: m.albedo,

@@ -101,7 +101,7 @@ type RenderOutput<'py> = (
     Vec<(String, usize, Bound<'py, PyBytes>)>,
 );
 
-/// Renders a scene file or volume (`path`) or a description (`scene_json`,
+/// Renders a scene file (TOML or a USD stage) or volume (`path`) or a description (`scene_json`,
 /// relative to `base_dir`), with overrides as JSON; writes the outputs the
 /// overrides or the file name.
 #[pyfunction]
@@ -150,13 +150,11 @@ fn render<'py>(
             })
             .collect(),
     };
-    Ok((
-        rgba,
-        image.width,
-        image.height,
-        rendered.stats.to_json(),
-        aovs,
-    ))
+    // What the scene's reader could not render rides with the stats.
+    let mut stats: serde_json::Value = serde_json::from_str(&rendered.stats.to_json())
+        .map_err(|e| PyValueError::new_err(format!("stats: {e}")))?;
+    stats["warnings"] = serde_json::json!(scene.warnings());
+    Ok((rgba, image.width, image.height, stats.to_string(), aovs))
 }
 
 /// Runs the render on its own thread and waits with the GIL released,

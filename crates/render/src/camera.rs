@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 
+use crate::camera_motion::{clip_near, CameraMotion};
 use crate::medium::Bounds3;
 use crate::ray::Ray;
 
@@ -20,6 +21,10 @@ pub struct Camera {
     right: Vec3,
     true_up: Vec3,
     tan_half: f32,
+    /// Poses over the shutter (`camera_motion.rs`); `None`: still.
+    motion: Option<CameraMotion>,
+    /// Near clipping distance along the view axis (0: none).
+    near: f32,
 }
 
 impl Camera {
@@ -43,7 +48,27 @@ impl Camera {
             right,
             true_up,
             tan_half: (0.5 * vfov_degrees.to_radians()).tan(),
+            motion: None,
+            near: 0.0,
         }
+    }
+
+    /// This camera moving through `motion`'s poses over the shutter.
+    pub fn with_motion(self, motion: CameraMotion) -> Self {
+        Self {
+            motion: Some(motion),
+            ..self
+        }
+    }
+
+    /// This camera seeing nothing nearer than `near` along its view axis.
+    pub fn with_near_clip(self, near: f32) -> Self {
+        Self { near, ..self }
+    }
+
+    /// Whether the camera moves while the shutter is open.
+    pub fn moves(&self) -> bool {
+        self.motion.is_some()
     }
 
     /// Frames the box `bounds` from a three-quarter view above and to the
@@ -113,5 +138,22 @@ impl Camera {
         let sy = (1.0 - 2.0 * py / self.height as f32) * self.tan_half;
         let dir = (self.forward + sx * self.right + sy * self.true_up).normalize();
         Ray::new(self.from, dir)
+    }
+
+    /// The ray of [`ray`](Self::ray) at shutter time `time`, from the
+    /// camera's pose then (`camera_motion.rs`) and clipped to its near
+    /// distance; exactly `ray` for a still, unclipped camera.
+    #[inline]
+    pub fn ray_at(&self, px: f32, py: f32, time: f32) -> Ray {
+        let (ray, forward) = match &self.motion {
+            None => (self.ray(px, py), self.forward),
+            Some(m) => {
+                let sx = (2.0 * px / self.width as f32 - 1.0) * self.tan_half * self.aspect();
+                let sy = (1.0 - 2.0 * py / self.height as f32) * self.tan_half;
+                let ray = m.ray(sx, sy, time);
+                (ray, m.pose_at(time).rotation * Vec3::NEG_Z)
+            }
+        };
+        clip_near(ray, forward, self.near).with_time(time)
     }
 }

@@ -43,6 +43,7 @@
 pub mod adaptive;
 pub mod blackbody;
 pub mod camera;
+pub mod camera_motion;
 pub mod control;
 pub mod distribution;
 pub mod env_map;
@@ -64,11 +65,13 @@ pub mod sobol;
 pub mod spectrum;
 pub mod stats;
 pub mod tracking;
+pub mod transform_motion;
 pub mod volumes;
 
 pub use adaptive::Adaptive;
 pub use blackbody::Blackbody;
 pub use camera::Camera;
+pub use camera_motion::{CameraMotion, CameraPose};
 pub use control::RenderControl;
 pub use env_map::EnvMap;
 pub use error::{Error, Result};

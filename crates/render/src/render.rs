@@ -360,7 +360,7 @@ impl<S: CameraSampler> Passes<'_, S> {
             let mut draws = SampleStream::new(self.kind, self.seed, index, s);
             let (u, v) = draws.get_2d(Draw::PixelJitter, 0);
             let time = self.shutter.sample(&draws);
-            let ray = self.camera.ray(x as f32 + u, y as f32 + v).with_time(time);
+            let ray = self.camera.ray_at(x as f32 + u, y as f32 + v, time);
             let sample = self.sampler.sample_stream(ray, &mut draws, c);
             tile.add(tx, ty, sample, c);
             if rule.is_some_and(|r| r.is_checkpoint(s + 1) && r.converged(&tile.pixels[i])) {

@@ -99,6 +99,12 @@ declare_settings! {
     /// Frames A-B[:STEP]: the frame number replaces `####` or `%04d` in
     /// every input and output path.
     frames: String, flag(long), unset("one frame, no pattern"), example("1-2".into());
+    @file_only {
+        /// The frame a single render shows: where time-sampled values
+        /// (`transform.samples`, `[camera] samples`, `file_samples`) are
+        /// read. `--frames` sets it to each frame; default 0.
+        frame: Option<f64>;
+    }
     }
 
     /// `[camera]`: where the image is seen from.
@@ -119,6 +125,30 @@ declare_settings! {
         default([0.0, 1.0, 0.0]), example([0.0, 0.0, 1.0]);
     /// Vertical field of view in degrees.
     fov: f32, flag(long), default(40.0), example(25.0);
+    @file_only {
+        /// Camera to world, a 4x4 matrix (rows; column vectors, the
+        /// translation in the last column): the camera looks along its -Z
+        /// axis with +Y up, as in USD and Blender. Exclusive with
+        /// `from`/`to`.
+        matrix: Option<Matrix>;
+        /// Time-sampled camera-to-world matrices, `[{ time, matrix }]`
+        /// (frames), interpolated between samples: motion blur when the
+        /// shutter is open.
+        samples: Option<Vec<MatrixSample>>;
+        /// Focal length (any one unit with the apertures, USD's tenths of
+        /// a scene unit or millimetres): the field of view, instead of
+        /// `fov`.
+        focal_length: Option<f32>;
+        /// Horizontal aperture, expanded to the image's aspect (USD's
+        /// `expandAperture`).
+        horizontal_aperture: Option<f32>;
+        /// Vertical aperture.
+        vertical_aperture: Option<f32>;
+        /// `[near, far]` distances along the view axis: nothing nearer
+        /// than `near` is seen (far is recorded and warned about, not
+        /// clipped).
+        clipping: Option<[f32; 2]>;
+    }
     }
 
     /// `[sun]`: a directional light, optionally a small disc.
@@ -212,8 +242,31 @@ declare_settings! {
         /// euler = [x, y, z] (degrees, about X then Y then Z), scale }`,
         /// applied scale, then rotate, then translate.
         transform: TransformSpec = serde(default);
+        /// Time-sampled files, `[{ time, file }]` (frames): the frame
+        /// rendered reads the sample held at its time (the last at or
+        /// before it, else the first).
+        file_samples: Option<Vec<FileSample>>;
     }
     }
+}
+
+/// A 4x4 matrix as rows (column vectors: the translation is the last column).
+pub type Matrix = [[f64; 4]; 4];
+
+/// A matrix at a time in frames.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MatrixSample {
+    pub time: f64,
+    pub matrix: Matrix,
+}
+
+/// A volume file from a time on (held until the next sample).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FileSample {
+    pub time: f64,
+    pub file: PathBuf,
 }
 
 /// A number or an RGB triple.
@@ -259,6 +312,13 @@ pub struct TransformSpec {
     pub euler: Option<[f64; 3]>,
     /// Uniform (a number) or per axis.
     pub scale: Option<ScaleSpec>,
+    /// Object to world as a 4x4 matrix (rows, column vectors), exclusive
+    /// with the fields above.
+    pub matrix: Option<Matrix>,
+    /// Time-sampled object-to-world matrices (frames), interpolated between
+    /// samples (translation and scale linearly, rotation by slerp): motion
+    /// blur when the shutter is open. Exclusive with the fields above.
+    pub samples: Option<Vec<MatrixSample>>,
 }
 
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -312,6 +372,9 @@ impl SceneDescription {
     pub fn rebase(&mut self, dir: &Path) {
         for v in &mut self.volumes {
             v.file = dir.join(&v.file);
+            for s in v.file_samples.iter_mut().flatten() {
+                s.file = dir.join(&s.file);
+            }
             if let Some(table) = v.phase.as_deref().and_then(|p| p.strip_prefix("table:")) {
                 v.phase = Some(format!("table:{}", dir.join(table).display()));
             }
@@ -324,9 +387,14 @@ impl SceneDescription {
     /// Every input and output path with its frame pattern replaced by `frame`.
     pub fn substitute_frame(&mut self, frame: i64) {
         use crate::frames::substitute;
+        self.render.frame = Some(frame as f64);
         for v in &mut self.volumes {
             v.file = substitute(&v.file, frame);
+            for s in v.file_samples.iter_mut().flatten() {
+                s.file = substitute(&s.file, frame);
+            }
         }
+        crate::timeline::hold_file_samples(self);
         if let Some(map) = self.environment.as_mut().and_then(|e| e.env_map.as_mut()) {
             *map = substitute(map, frame);
         }
@@ -339,7 +407,7 @@ impl SceneDescription {
         }
     }
 
-    /// What serde cannot say: exclusive fields.
+    /// What serde cannot say: exclusive fields, ordered samples.
     fn check(&self) -> std::result::Result<(), String> {
         for (i, v) in self.volumes.iter().enumerate() {
             if v.transform.rotate.is_some() && v.transform.euler.is_some() {
@@ -349,8 +417,10 @@ impl SceneDescription {
                     v.file.display()
                 ));
             }
+            crate::timeline::check_volume(v)
+                .map_err(|e| format!("volume {} ({}): {e}", i + 1, v.file.display()))?;
         }
-        Ok(())
+        crate::timeline::check_camera(&self.camera).map_err(|e| format!("[camera] {e}"))
     }
 }
 

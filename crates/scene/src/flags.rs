@@ -14,7 +14,7 @@ use crate::overrides::Overrides;
 /// What to render and how: every flag but the outputs.
 #[derive(clap::Args, Clone, Debug)]
 pub struct SceneFlags {
-    /// A .vdb, .nvdb or .cbrk file, or a scene file (.toml).
+    /// A .vdb, .nvdb or .cbrk file, a scene file (.toml) or a USD stage (.usd, .usda, .usdc, .usdz).
     pub file: PathBuf,
     #[command(flatten)]
     pub render: RenderFlags,

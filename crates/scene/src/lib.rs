@@ -45,6 +45,7 @@ mod flags;
 pub mod frames;
 pub mod grids;
 pub mod info;
+mod moving;
 mod output;
 mod overrides;
 pub mod parse;
@@ -52,6 +53,8 @@ mod plan;
 mod prepare;
 mod scene;
 mod settings;
+pub mod timeline;
+pub mod usd;
 
 pub use declare::{SettingInfo, Shown};
 pub use denoise::{denoise, denoise_available};

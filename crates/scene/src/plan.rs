@@ -37,7 +37,7 @@ pub struct Plan {
     velocity: Option<usize>,
     velocity_unit: VelocityUnit,
     velocity_scale: f32,
-    object_to_world: DMat4,
+    pub(crate) object_to_world: DMat4,
     /// From the grid header, when the file says.
     pub world_box: Option<DBounds3>,
     density_scale: Option<Colour>,
@@ -75,6 +75,9 @@ pub enum GridPrecision {
 
 fn object_to_world(v: &VolumeSpec) -> DMat4 {
     let t = &v.transform;
+    if let Some(m) = &t.matrix {
+        return crate::timeline::to_dmat4(m);
+    }
     let translate = DMat4::from_translation(DVec3::from_array(t.translate.unwrap_or([0.0; 3])));
     let rotate = match (&t.rotate, t.euler) {
         (Some(r), _) => {
@@ -224,6 +227,9 @@ pub struct VolumeCache {
     grids: HashMap<GridKey, BrickVolume>,
     velocities: HashMap<(PathBuf, usize), Arc<VelocityGrid>>,
     cbrk_bytes: u64,
+    /// The pose tables and shells of the last prepared scene's moving
+    /// volumes, per kept volume (`moving.rs`).
+    pub(crate) poses: Vec<Option<crate::moving::Pose>>,
 }
 
 /// A grid of a file as it is stored: file, grid index, precision.
@@ -261,6 +267,11 @@ impl VolumeCache {
     /// A plan's density grid, loading it.
     pub fn density(&mut self, p: &Plan) -> Result<&BrickVolume> {
         self.grid(p, p.density)
+    }
+
+    /// A plan's loaded density grid.
+    pub(crate) fn density_volume(&self, p: &Plan) -> &BrickVolume {
+        &self.grids[&p.grid_key(p.density)]
     }
 
     /// The world box of a plan's density grid, loading it.
@@ -368,6 +379,36 @@ impl VolumeCache {
             });
         }
         Ok(inst)
+    }
+
+    /// The field whose segments bound a moving plan's density over every
+    /// pose: its `shell` placed as the plan is, walked as its density is.
+    pub(crate) fn bound_field<'v>(
+        &'v self,
+        p: &Plan,
+        shell: &'v BrickVolume,
+        centre: DVec3,
+        settings: &crate::settings::SceneSettings,
+        shutter: Shutter,
+    ) -> Result<BrickField<'v>> {
+        let field = BrickField::new(shell, p.object_to_world, centre);
+        let extinction = extinction(&p.file, p.density_scale, field.voxel_size())?;
+        let field = walk_cells(
+            field,
+            settings.render.integrator,
+            extinction.scale,
+            settings.refine_optical_depth,
+        );
+        let velocity = self.velocity_of(p);
+        moved(field, velocity.as_ref(), shutter, &p.file)
+    }
+
+    fn velocity_of(&self, p: &Plan) -> Option<Velocity> {
+        p.velocity.map(|index| Velocity {
+            grid: self.velocities[&(p.file.clone(), index)].clone(),
+            unit: p.velocity_unit,
+            scale: p.velocity_scale,
+        })
     }
 
     pub fn bytes_read(&self) -> u64 {

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use cirrus_bricks::{Bounds3, DBounds3};
 use cirrus_render::medium::BrickField;
+use cirrus_render::transform_motion::MovingField;
 use cirrus_render::{Camera, Crop, DensityField, RenderSettings, Rendered, Volumes};
 use glam::DVec3;
 
@@ -44,7 +45,7 @@ impl Placement {
 
 /// What the renderer takes, with what it cost to load.
 pub struct Prepared<'c> {
-    pub scene: cirrus_render::Scene<Volumes<BrickField<'c>>>,
+    pub scene: cirrus_render::Scene<Volumes<MovingField<BrickField<'c>>>>,
     pub settings: RenderSettings,
     /// The world position of render space's origin.
     pub centre: DVec3,
@@ -80,6 +81,14 @@ pub fn prepare<'c>(
     let start = Instant::now();
     let shutter = settings.render.shutter;
     let moving = shutter.max_abs_time() > 0.0;
+    // Time-sampled transforms read at the frame, and over the shutter.
+    let frame = crate::timeline::frame_of(desc);
+    let tracks: Vec<_> = desc
+        .volumes
+        .iter()
+        .map(|v| crate::moving::track(v, frame, [shutter.open, shutter.close]))
+        .collect();
+    let desc = &crate::timeline::at_frame(desc);
     let plans = desc
         .volumes
         .iter()
@@ -100,34 +109,45 @@ pub fn prepare<'c>(
             (centre, union.relative_to(centre))
         }
     };
-    let camera = camera(&settings, centre, framed);
-    // Culling sees where the density can move to over the shutter; the
-    // framing and render space above stay those of the still frame.
+    let camera = match crate::moving::camera(desc, &settings, centre)? {
+        Some(c) => c,
+        None => camera(&settings, centre, framed),
+    };
+    // Culling sees where the density can move to over the shutter (its
+    // transform's poses, its velocity); the framing and render space above
+    // stay those of the still frame.
     let boxes: Vec<DBounds3> = plans
         .iter()
         .zip(boxes)
-        .map(|(p, b)| cache.motion_box(p, b, shutter))
+        .zip(&tracks)
+        .map(|((p, b), t)| {
+            let b = t.as_ref().map_or(b, |t| t.swept(b));
+            cache.motion_box(p, b, shutter)
+        })
         .collect::<Result<_>>()?;
     let keep = reachable(&settings, &camera, &plans, &boxes, centre);
 
     // Read what is needed, then place it.
-    let kept = || plans.iter().zip(&keep).filter(|(_, k)| **k).map(|(p, _)| p);
-    for p in kept() {
+    let kept = || {
+        plans
+            .iter()
+            .zip(&tracks)
+            .zip(&keep)
+            .filter(|(_, k)| **k)
+            .map(|(p, _)| p)
+    };
+    for (p, _) in kept() {
         cache.load_grids(p)?;
     }
+    // Moving volumes' pose tables and the shells bounding their poses,
+    // kept by the cache for as long as this scene borrows it.
+    cache.poses = crate::moving::poses(cache, kept(), centre)?;
     let cache: &'c VolumeCache = cache;
-    let r = &settings.render;
     let instances = kept()
-        .map(|p| {
-            cache.instance(
-                p,
-                centre,
-                r.integrator,
-                settings.refine_optical_depth,
-                shutter,
-            )
-        })
+        .zip(&cache.poses)
+        .map(|((p, _), pose)| crate::moving::instance(cache, p, pose.as_ref(), centre, &settings))
         .collect::<Result<Vec<_>>>()?;
+    let r = &settings.render;
     if instances.is_empty() {
         return Err(Error::input(
             "no volume is visible and none can light one: nothing to render",
@@ -176,9 +196,10 @@ fn reachable(
         x1: w,
         y1: h,
     });
+    // A moving camera sees more than its frame's frustum.
     let visible: Vec<bool> = boxes
         .iter()
-        .map(|b| in_frustum(camera, window, b.relative_to(centre)))
+        .map(|b| camera.moves() || in_frustum(camera, window, b.relative_to(centre)))
         .collect();
     let any_emission = plans.iter().any(|p| p.emits());
     needed(

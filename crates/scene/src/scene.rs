@@ -32,12 +32,21 @@ pub struct Scene {
     placement: Placement,
     /// Draw a progress bar on a terminal's stderr while rendering.
     pub progress_bar: bool,
+    /// What the scene's reader could not render (a USD stage's meshes...).
+    warnings: Vec<String>,
 }
 
 impl Scene {
-    /// A scene file (`.toml`), or a lone `.vdb`, `.nvdb` or `.cbrk` volume.
+    /// A scene file (`.toml`), a USD stage (`.usd`, `.usda`, `.usdc`,
+    /// `.usdz`; `usd/`), or a lone `.vdb`, `.nvdb` or `.cbrk` volume.
     pub fn load(path: &Path) -> Result<Scene> {
-        if path.extension().is_some_and(|e| e == "toml") {
+        if crate::usd::is_usd(path) {
+            let stage = crate::usd::read(path)?;
+            let mut scene = Scene::from_description(stage.description, parent(path))
+                .map_err(|e| e.within(path.display()))?;
+            scene.warnings = stage.warnings;
+            Ok(scene)
+        } else if path.extension().is_some_and(|e| e == "toml") {
             let description = SceneDescription::read(path)?;
             Scene::from_description(description, parent(path)).map_err(|e| e.within(path.display()))
         } else {
@@ -57,6 +66,7 @@ impl Scene {
             },
             placement: Placement::OwnGrid,
             progress_bar: false,
+            warnings: Vec::new(),
         }
     }
 
@@ -66,11 +76,18 @@ impl Scene {
             return Err(Error::input("no [[volume]] in the scene"));
         }
         description.rebase(dir);
+        crate::timeline::hold_file_samples(&mut description);
         Ok(Scene {
             description,
             placement: Placement::Volumes,
             progress_bar: false,
+            warnings: Vec::new(),
         })
+    }
+
+    /// What the reader could not render (listed, never fatal).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     pub fn description(&self) -> &SceneDescription {

@@ -26,7 +26,7 @@ pub fn run(args: &RenderArgs) -> CliResult {
     let mut overrides = args.scene.overrides();
     args.output.write_into(&mut overrides);
     let file = &args.scene.file;
-    match frame_range(args)? {
+    match frame_range(args, &overrides)? {
         None => {
             let scene = load(file, &overrides, None)?;
             render_one(&scene, true)?;
@@ -37,7 +37,10 @@ pub fn run(args: &RenderArgs) -> CliResult {
 }
 
 /// `--frames`, else a scene file's `[render] frames`, else none.
-fn frame_range(args: &RenderArgs) -> Result<Option<FrameRange>, Box<dyn std::error::Error>> {
+fn frame_range(
+    args: &RenderArgs,
+    overrides: &Overrides,
+) -> Result<Option<FrameRange>, Box<dyn std::error::Error>> {
     let file = &args.scene.file;
     if let Some(s) = &args.scene.render.frames {
         return Ok(Some(FrameRange::parse(s)?));
@@ -45,7 +48,18 @@ fn frame_range(args: &RenderArgs) -> Result<Option<FrameRange>, Box<dyn std::err
     if has_pattern(&file.to_string_lossy()) {
         return Err(format!("{}: a frame pattern needs --frames A-B", file.display()).into());
     }
-    let from_file = match file.extension().is_some_and(|e| e == "toml") {
+    // A stage's own range renders when the outputs can tell its frames
+    // apart; with one output file it renders its first frame.
+    let usd = cirrus_scene::usd::is_usd(file);
+    let patterned = |p: &Option<PathBuf>| {
+        p.as_ref()
+            .is_some_and(|p| has_pattern(&p.to_string_lossy()))
+    };
+    if usd && overrides.output.is_some() && !patterned(&overrides.output) {
+        return Ok(None);
+    }
+    let scene_file = file.extension().is_some_and(|e| e == "toml") || usd;
+    let from_file = match scene_file {
         true => Scene::load(file)?.description().render.frames.clone(),
         false => None,
     };
@@ -74,6 +88,9 @@ fn render_one(scene: &Scene, bar: bool) -> Result<PathBuf, Box<dyn std::error::E
                 .into(),
         );
     };
+    for warning in scene.warnings() {
+        eprintln!("cirrus: warning: {warning}");
+    }
     let mut scene = scene.clone();
     scene.progress_bar = bar;
     let rendered = scene.render()?;

@@ -4,8 +4,8 @@
     image, stats = cirrus.render("data/cloud.vdb", res="256x256", spp=16)
     image.shape            # (256, 256, 4) float32, alpha = 1 - transmittance
 
-`render` takes a scene file, a volume file or a dict in the scene-file
-format, and keyword overrides named as the `cirrus render` flags
+`render` takes a scene file (TOML, or a USD stage: .usd, .usda, .usdc,
+.usdz), a volume file or a dict in the scene-file format, and keyword overrides named as the `cirrus render` flags
 (`res`, `spp`, `seed`, `camera_from`, `sun_dir`, `albedo`, `aov`, ...).
 `open` returns a file's grids as `cirrus info --json` reports them, and
 `convert` writes sparse bricks. Errors are `OSError` for files and
@@ -16,13 +16,19 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
 from . import _cirrus
 
-__all__ = ["open", "render", "convert", "VolumeFile", "Grid"]
+__all__ = ["open", "render", "convert", "VolumeFile", "Grid", "SceneWarning"]
+
+
+class SceneWarning(UserWarning):
+    """Something the scene holds that cirrus does not render (a USD stage's
+    meshes, a material input it cannot evaluate): listed, never fatal."""
 
 
 class Grid:
@@ -97,7 +103,8 @@ def render(
     """Renders a scene file, a volume file or a scene dict.
 
     Returns the image as a float32 array (H, W, 4) and the statistics as a
-    dict; with ``aov=[...]`` the statistics hold ``"aovs"``, one float32
+    dict (``"warnings"``: what the scene's reader could not render, also
+    issued as :class:`SceneWarning`); with ``aov=[...]`` the statistics hold ``"aovs"``, one float32
     (H, W, C) array per layer. ``progress(done, total)`` is called about
     every 50 ms once rendering has begun; if it raises, the render stops and the exception
     propagates, as Ctrl-C does. ``threads`` sets the worker count (the
@@ -115,6 +122,8 @@ def render(
     )
     image = np.frombuffer(rgba, dtype="<f4").reshape(height, width, 4).copy()
     stats = json.loads(stats_json)
+    for message in stats.get("warnings", []):
+        warnings.warn(message, SceneWarning, stacklevel=2)
     if aovs:
         stats["aovs"] = {
             name: np.frombuffer(data, dtype="<f4").reshape(height, width, n).copy()

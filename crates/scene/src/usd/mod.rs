@@ -1,0 +1,336 @@
+//! USD stages (`.usda`, `.usdc`, `.usdz`) read into a scene description,
+//! beside the TOML reader: the same [`SceneDescription`], so a stage
+//! renders exactly as the scene file saying the same things would.
+//!
+//! The stage is opened and composed by the `openusd` crate (a native
+//! reader: sublayers, references, payloads, inherits, specializes,
+//! variants, instancing). Any composition error (a cyclic arc, a layer that
+//! cannot be read or found) fails the read with the error, naming the prim
+//! and the layer. What cirrus renders:
+//!
+//! - `Volume` prims and their `OpenVDBAsset` fields (`volume.rs`), each
+//!   with its world transform (composed through its parents, instance
+//!   proxies included: each instance of a prototype is its own volume) and
+//!   bound material (`material.rs`);
+//! - `DistantLight` as the sun and `DomeLight` as the sky (`lights.rs`);
+//! - the camera the `RenderSettings` name, else the first `Camera`, and the
+//!   settings' resolution (`camera.rs`);
+//! - time: the stage's `startTimeCode`-`endTimeCode` become the frames
+//!   rendered (frames are time codes), and time-sampled transforms and
+//!   `filePath`s become samples the renderer reads at each frame and over
+//!   the camera's shutter (`shutter:open`, `shutter:close`).
+//!
+//! Every other prim (meshes, other lights, ...) is listed once in a
+//! warning with its path and type: never fatal, never silently dropped.
+//! VDBs and sky maps packaged inside a `.usdz` are copied out to the
+//! temporary directory once (`package.rs`). The `openusd` reader is guarded: a stage is read first in a child
+//! process (`isolate.rs`), so one that crashes or hangs it is an error
+//! naming the file, and a panic inside it becomes an error too.
+
+mod camera;
+mod isolate;
+mod lights;
+pub mod material;
+mod package;
+mod values;
+mod volume;
+mod xform;
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::Path;
+
+use openusd::usd::{PrimPredicate, Stage};
+
+use crate::description::{EnvironmentSpec, SceneDescription, SunSpec};
+use crate::error::{Error, Result};
+
+/// A stage read into a description, with what the reader could not render.
+pub struct StageScene {
+    pub description: SceneDescription,
+    pub warnings: Vec<String>,
+}
+
+/// Whether `path` names a USD file (by its extension).
+pub fn is_usd(path: &Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        matches!(
+            e.to_ascii_lowercase().as_str(),
+            "usd" | "usda" | "usdc" | "usdz"
+        )
+    })
+}
+
+/// The stage's clock.
+pub struct Time {
+    pub start: f64,
+    pub end: f64,
+    pub frames_per_second: f64,
+    pub authored_range: bool,
+}
+
+/// A stage being read: what the readers of each prim type share.
+pub struct Reader {
+    pub stage: Stage,
+    /// The stage file, as errors name it.
+    pub file: String,
+    pub time: Time,
+    warnings: Vec<String>,
+}
+
+impl Reader {
+    pub fn warn(&mut self, message: String) {
+        if !self.warnings.contains(&message) {
+            self.warnings.push(message);
+        }
+    }
+
+    /// An input error naming the stage file and the prim.
+    pub fn error(&self, prim: &str, what: impl std::fmt::Display) -> Error {
+        values::prim_error(&self.file, prim, what)
+    }
+}
+
+/// Reads the stage at `path`; see the module doc.
+pub fn read(path: &Path) -> Result<StageScene> {
+    let file = path.display().to_string();
+    std::fs::metadata(path).map_err(|e| Error::file(format!("{file}: {e}")))?;
+    let text = path
+        .to_str()
+        .ok_or_else(|| Error::file(format!("{file}: the path is not UTF-8")))?;
+    // First in a child process (`isolate.rs`): a file that crashes or hangs
+    // the reader fails here, naming it.
+    isolate::trial(|| {
+        read_guarded(text, &file)
+            .map(drop)
+            .map_err(|e| e.to_string())
+    })
+    .map_err(|why| Error::input(format!("{file}: {why}")))?;
+    match catch_unwind(AssertUnwindSafe(|| read_guarded(text, &file))) {
+        Ok(result) => result,
+        Err(panic) => {
+            let why = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown failure".into());
+            Err(Error::input(format!(
+                "{file}: the USD reader failed: {why}"
+            )))
+        }
+    }
+}
+
+fn read_guarded(text: &str, file: &str) -> Result<StageScene> {
+    let stage = Stage::open(text).map_err(|e| {
+        let e = format!("{e:#}");
+        // openusd 0.6's text parser takes no asset values in timeSamples.
+        let hint = match e.contains("AssetRef") {
+            true => " (time-sampled asset paths, such as a per-frame filePath, are read from .usdc layers, not .usda)",
+            false => "",
+        };
+        Error::input(format!("{file}: {e}{hint}"))
+    })?;
+    let time = Time {
+        start: stage.start_time_code(),
+        end: stage.end_time_code(),
+        frames_per_second: stage.frames_per_second(),
+        authored_range: stage.has_authored_time_code_range(),
+    };
+    if !(time.start.is_finite() && time.end.is_finite() && time.end >= time.start) {
+        return Err(Error::input(format!(
+            "{file}: time codes {}-{}: expected finite start <= end",
+            time.start, time.end
+        )));
+    }
+    if !(time.frames_per_second.is_finite() && time.frames_per_second > 0.0) {
+        return Err(Error::input(format!("{file}: framesPerSecond must be > 0")));
+    }
+    let mut reader = Reader {
+        stage,
+        file: file.to_string(),
+        time,
+        warnings: Vec::new(),
+    };
+    let prims = traverse(&reader)?;
+    composition_errors(&reader)?;
+    let description = describe(&mut reader, &prims)?;
+    composition_errors(&reader)?;
+    Ok(StageScene {
+        description,
+        warnings: reader.warnings,
+    })
+}
+
+/// Every prim of the default traversal (instance proxies included) with
+/// its type.
+fn traverse(r: &Reader) -> Result<Vec<(String, String)>> {
+    let mut paths = Vec::new();
+    r.stage
+        .traverse(PrimPredicate::DEFAULT_PROXIES, |p| {
+            paths.push(p.as_str().to_string())
+        })
+        .map_err(|e| Error::input(format!("{}: {e:#}", r.file)))?;
+    paths
+        .into_iter()
+        .map(|p| Ok((values::type_name(&r.stage, &p)?, p)))
+        .map(|x: Result<(String, String)>| x.map(|(t, p)| (p, t)))
+        .collect()
+}
+
+/// Fails on the stage's composition errors, listing them.
+fn composition_errors(r: &Reader) -> Result<()> {
+    let errors = r.stage.composition_errors();
+    if errors.is_empty() {
+        return Ok(());
+    }
+    let listed: Vec<String> = errors.iter().map(|e| e.to_string()).collect();
+    Err(Error::input(format!("{}: {}", r.file, listed.join("; "))))
+}
+
+/// Prim types that only organise or feed what cirrus reads.
+const STRUCTURAL: [&str; 10] = [
+    "",
+    "Xform",
+    "Scope",
+    "Material",
+    "Shader",
+    "NodeGraph",
+    "OpenVDBAsset",
+    "RenderProduct",
+    "RenderVar",
+    "GeomSubset",
+];
+
+fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescription> {
+    let of = |kind: &[&str]| -> Vec<String> {
+        prims
+            .iter()
+            .filter(|(_, t)| kind.contains(&t.as_str()))
+            .map(|(p, _)| p.clone())
+            .collect()
+    };
+    let unsupported: Vec<String> = prims
+        .iter()
+        .filter(|(_, t)| {
+            !STRUCTURAL.contains(&t.as_str())
+                && ![
+                    "Volume",
+                    "DistantLight",
+                    "DomeLight",
+                    "DomeLight_1",
+                    "Camera",
+                    "RenderSettings",
+                ]
+                .contains(&t.as_str())
+        })
+        .map(|(p, t)| format!("{p} ({t})"))
+        .collect();
+    if !unsupported.is_empty() {
+        r.warn(format!(
+            "{}: not rendered (cirrus renders volumes, a distant light, a dome light and a camera): {}",
+            r.file,
+            unsupported.join(", ")
+        ));
+    }
+    let mut desc = SceneDescription::default();
+    for path in of(&["Volume"]) {
+        desc.volumes.push(volume::read(r, &path)?);
+    }
+    if desc.volumes.is_empty() {
+        return Err(Error::input(format!(
+            "{}: the stage has no Volume prim to render",
+            r.file
+        )));
+    }
+    lights(
+        r,
+        &of(&["DistantLight"]),
+        &of(&["DomeLight", "DomeLight_1"]),
+        &mut desc,
+    )?;
+    view(r, &of(&["Camera"]), &of(&["RenderSettings"]), &mut desc)?;
+    if r.time.authored_range {
+        let (first, last) = (r.time.start.ceil(), r.time.end.floor());
+        if last >= first {
+            desc.render.frames = Some(format!("{}-{}", first as i64, last as i64));
+        }
+    }
+    desc.render.frame = Some(r.time.start);
+    Ok(desc)
+}
+
+/// The first distant light is the sun, the first dome the sky; a stage
+/// without one has none (no default sun or sky is added).
+fn lights(
+    r: &mut Reader,
+    suns: &[String],
+    domes: &[String],
+    desc: &mut SceneDescription,
+) -> Result<()> {
+    for (kind, extra) in [("DistantLight", suns), ("DomeLight", domes)] {
+        if extra.len() > 1 {
+            r.warn(format!(
+                "{}: only the first {kind} is rendered; not rendered: {}",
+                r.file,
+                extra[1..].join(", ")
+            ));
+        }
+    }
+    desc.sun = Some(match suns.first() {
+        Some(p) => lights::distant(r, p)?,
+        None => SunSpec {
+            sun: Some(false),
+            ..Default::default()
+        },
+    });
+    desc.environment = Some(match domes.first() {
+        Some(p) => lights::dome(r, p)?,
+        None => EnvironmentSpec {
+            env_radiance: Some([0.0; 3]),
+            ..Default::default()
+        },
+    });
+    if suns.is_empty() && domes.is_empty() {
+        r.warn(format!(
+            "{}: the stage has no DistantLight or DomeLight: the volumes are unlit",
+            r.file
+        ));
+    }
+    Ok(())
+}
+
+/// The camera and resolution.
+fn view(
+    r: &mut Reader,
+    cameras: &[String],
+    settings: &[String],
+    desc: &mut SceneDescription,
+) -> Result<()> {
+    let settings = match settings.first() {
+        Some(p) => Some(camera::render_settings(r, p)?),
+        None => None,
+    };
+    let chosen = settings
+        .as_ref()
+        .and_then(|s| s.camera.clone())
+        .or_else(|| cameras.first().cloned());
+    if let Some(path) = chosen {
+        if cameras.len() > 1 {
+            r.warn(format!(
+                "{}: rendering through {path}; other cameras: {}",
+                r.file,
+                cameras.len() - 1
+            ));
+        }
+        let (spec, shutter) = camera::camera(r, &path)?;
+        desc.camera = spec;
+        desc.render.shutter = shutter;
+    } else {
+        r.warn(format!(
+            "{}: the stage has no Camera: the volumes are framed",
+            r.file
+        ));
+    }
+    desc.camera.res = settings.and_then(|s| s.res);
+    Ok(())
+}

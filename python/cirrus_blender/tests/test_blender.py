@@ -1,0 +1,260 @@
+"""The cirrus add-on inside Blender (PyPI's bpy, headless): installed from
+its extension zip, it renders a scene built in Blender as Cycles renders
+it (within noise, per block), renders animations, and reports what it
+cannot map. Run by tools/test_blender.sh under CPython 3.13.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+# Blender's user folders (where extensions install) in a scratch place.
+os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="cirrus-blender-"))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[3]
+ADDON = REPO / "python" / "cirrus_blender"
+MODULE = "bl_ext.user_default.cirrus"
+CLOUD = REPO / "data" / "cloud.vdb"
+RES = 64
+ALBEDO, DENSITY_PER_VOXEL, G = 0.8, 0.5, 0.4
+SUN = dict(energy=3.0, color=(1.0, 0.95, 0.9), angle=math.radians(0.53))
+SKY = (0.10, 0.15, 0.25)
+
+
+def build_zip(out: Path) -> Path:
+    with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
+        for p in sorted(ADDON.glob("*.py")) + [ADDON / "blender_manifest.toml"]:
+            z.write(p, p.name)
+    return out
+
+
+@pytest.fixture(scope="module")
+def addon(tmp_path_factory):
+    """The add-on installed from its zip, as Blender's Install from Disk does."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    zip_path = build_zip(tmp_path_factory.mktemp("addon") / "cirrus.zip")
+    result = bpy.ops.extensions.package_install_files(
+        filepath=str(zip_path), repo="user_default", enable_on_install=True)
+    assert result == {"FINISHED"}
+    return sys.modules[MODULE]
+
+
+def voxel_size(vol) -> float:
+    m = vol.grids["density"].matrix_object
+    return math.sqrt(sum(m[r][0] ** 2 for r in range(3)))
+
+
+def look_at(eye, target):
+    import mathutils
+
+    eye, target = mathutils.Vector(eye), mathutils.Vector(target)
+    return mathutils.Matrix.Translation(eye) @ (target - eye).to_track_quat("-Z", "Y").to_matrix().to_4x4()
+
+
+def build_scene(extra_mesh: bool = False):
+    """The corpus cloud as a volume object under a sun, a world colour and
+    a camera; its Principled Volume is grey, albedo ALBEDO."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    # Factory settings disable add-ons; the installed extension stays.
+    bpy.ops.preferences.addon_enable(module=MODULE)
+    scene = bpy.context.scene
+    vol = bpy.data.volumes.new("cloud")
+    vol.filepath = str(CLOUD)
+    vol.render.precision = "FULL"
+    vol.render.clipping = 0.0
+    vol.grids.load()
+    obj = bpy.data.objects.new("Cloud", vol)
+    scene.collection.objects.link(obj)
+    mat = bpy.data.materials.new("Smoke")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    pv = nt.nodes.new("ShaderNodeVolumePrincipled")
+    pv.inputs["Color"].default_value = (ALBEDO, ALBEDO, ALBEDO, 1.0)
+    pv.inputs["Density"].default_value = DENSITY_PER_VOXEL / voxel_size(vol)
+    pv.inputs["Anisotropy"].default_value = G
+    pv.inputs["Absorption Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    nt.links.new(pv.outputs["Volume"], out.inputs["Volume"])
+    vol.materials.append(mat)
+    # Camera and sun around the cloud's box (Blender is Z-up).
+    import mathutils
+
+    bpy.context.view_layer.update()
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    corners = [obj.matrix_world @ mathutils.Vector(c) for c in evaluated.bound_box]
+    lo = [min(c[i] for c in corners) for i in range(3)]
+    hi = [max(c[i] for c in corners) for i in range(3)]
+    centre = [(a + b) / 2 for a, b in zip(lo, hi)]
+    size = max(b - a for a, b in zip(lo, hi))
+    cam_data = bpy.data.cameras.new("Cam")
+    cam_data.sensor_fit = "VERTICAL"
+    cam_data.angle_y = math.radians(40.0)
+    cam_data.clip_start = 1e-3
+    cam_data.clip_end = 1e7
+    cam = bpy.data.objects.new("Cam", cam_data)
+    eye = (centre[0] + 0.2 * size, centre[1] - 1.05 * size, centre[2] + 0.3 * size)
+    cam.matrix_world = look_at(eye, centre)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    sun_data = bpy.data.lights.new("Sun", "SUN")
+    sun_data.energy, sun_data.color, sun_data.angle = SUN["energy"], SUN["color"], SUN["angle"]
+    sun_data.normalize = True  # strength is the irradiance (cirrus's unit)
+    sun = bpy.data.objects.new("Sun", sun_data)
+    sun.rotation_euler = (math.radians(40.0), 0.0, math.radians(30.0))
+    scene.collection.objects.link(sun)
+    world = bpy.data.worlds.new("Sky")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (*SKY, 1.0)
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    scene.world = world
+    if extra_mesh:
+        bpy.ops.mesh.primitive_cube_add(size=1.0, location=(1e4, 0, 0))
+    r = scene.render
+    r.resolution_x = r.resolution_y = RES
+    r.resolution_percentage = 100
+    r.film_transparent = False
+    r.use_compositing = False
+    r.use_sequencer = False
+    r.threads_mode = "FIXED"
+    r.threads = 2
+    r.image_settings.file_format = "OPEN_EXR"
+    r.image_settings.color_depth = "32"
+    r.image_settings.color_mode = "RGBA"
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    return scene, mat
+
+
+def cycles_settings(scene, spp: int, seed: int) -> None:
+    """A fair Cycles: unbiased null-scattering volumes, no clamping, no
+    adaptive sampling, box filter of one pixel, independent pixels."""
+    scene.render.engine = "CYCLES"
+    cy = scene.cycles
+    cy.device = "CPU"
+    cy.samples = spp
+    cy.seed = seed
+    cy.use_adaptive_sampling = False
+    cy.sample_clamp_direct = cy.sample_clamp_indirect = 0.0
+    cy.light_sampling_threshold = 0.0
+    cy.sampling_pattern = "TABULATED_SOBOL"
+    cy.volume_biased = False
+    cy.pixel_filter_type = "BOX"
+    cy.filter_width = 1.0
+    cy.use_guiding = False
+    cy.max_bounces = cy.volume_bounces = cy.transparent_max_bounces = 1024
+    cy.diffuse_bounces = cy.glossy_bounces = cy.transmission_bounces = 0
+    cy.min_light_bounces = cy.min_transparent_bounces = 0
+    cy.use_denoising = False
+    cy.film_exposure = 1.0
+    for lamp in bpy.data.lights:
+        lamp.cycles.max_bounces = 1024
+
+
+def render_to_array(scene, path: Path) -> np.ndarray:
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(str(path), check_existing=False)
+    w, h = img.size
+    px = np.array(img.pixels[:], dtype=np.float64).reshape(h, w, 4)[::-1]
+    bpy.data.images.remove(img)
+    return px
+
+
+def block_stats(a: np.ndarray, b: np.ndarray, blocks: int):
+    """Per block: the mean of two renders and its variance, from the
+    per-pixel spread between them (pixels are independent)."""
+    h, w = a.shape
+    n = h // blocks
+    means, variances = np.zeros((blocks, blocks)), np.zeros((blocks, blocks))
+    for i in range(blocks):
+        for j in range(blocks):
+            sa = a[i * n:(i + 1) * n, j * n:(j + 1) * n]
+            sb = b[i * n:(i + 1) * n, j * n:(j + 1) * n]
+            means[i, j] = 0.5 * (sa.mean() + sb.mean())
+            var_pixel = 0.5 * np.mean((sa - sb) ** 2)
+            variances[i, j] = var_pixel / (2 * sa.size)
+    return means, variances
+
+
+def test_cirrus_renders_the_blender_scene_as_cycles_does(addon, tmp_path):
+    scene, _ = build_scene()
+    spp = 64
+    cyc = []
+    for seed in (1, 2):
+        cycles_settings(scene, spp, seed)
+        cyc.append(render_to_array(scene, tmp_path / f"cycles{seed}.exr"))
+    scene.render.engine = "CIRRUS"
+    scene.cirrus.spp = spp
+    cir = []
+    for seed in (1, 2):
+        scene.cirrus.seed = seed
+        cir.append(render_to_array(scene, tmp_path / f"cirrus{seed}.exr"))
+    reports = [m for level, m in addon.engine.REPORTS]
+    assert not any(level == "ERROR" for level, _ in addon.engine.REPORTS), reports
+    # The cloud: where cirrus's alpha says a volume is.
+    alpha = 0.5 * (cir[0][..., 3] + cir[1][..., 3])
+    cloud = alpha > 0.05
+    assert cloud.sum() > 0.1 * RES * RES, "the camera sees the cloud"
+    lum = lambda px: px[..., :3].mean(axis=-1)  # noqa: E731
+    ca, cb = lum(cir[0]), lum(cir[1])
+    ya, yb = lum(cyc[0]), lum(cyc[1])
+    # The cloud's mean: both renders of each, against the spread of pixels.
+    def masked(a, b):
+        d = (a - b)[cloud]
+        return 0.5 * (a[cloud].mean() + b[cloud].mean()), 0.5 * np.mean(d ** 2) / (2 * d.size)
+    mc, vc = masked(ca, cb)
+    my, vy = masked(ya, yb)
+    z = (mc - my) / math.sqrt(vc + vy)
+    print(f"cloud mean: cirrus {mc:.5f} +- {math.sqrt(vc):.5f}, cycles {my:.5f} +- {math.sqrt(vy):.5f}, z {z:+.2f}")
+    assert abs(z) < 5.0
+    # Per block of 16x16 pixels.
+    bc, vbc = block_stats(ca, cb, 4)
+    by, vby = block_stats(ya, yb, 4)
+    zb = (bc - by) / np.sqrt(vbc + vby + 1e-12)
+    print("block means cirrus:\n", np.round(bc, 4), "\ncycles:\n", np.round(by, 4), "\nz:\n", np.round(zb, 2))
+    assert np.all(np.abs(zb) < 5.0), zb
+
+
+def test_unmapped_nodes_and_objects_are_reported(addon, tmp_path):
+    scene, mat = build_scene(extra_mesh=True)
+    nt = mat.node_tree
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.name = "Noise Texture"
+    pv = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeVolumePrincipled")
+    nt.links.new(noise.outputs["Color"], pv.inputs["Color"])
+    scene.render.engine = "CIRRUS"
+    scene.render.resolution_x = scene.render.resolution_y = 8
+    scene.cirrus.spp = 1
+    render_to_array(scene, tmp_path / "reported.exr")
+    warnings = [m for level, m in addon.engine.REPORTS if level == "WARNING"]
+    assert any("Noise Texture" in m and "Color" in m for m in warnings), warnings
+    assert any(m.startswith("Cube (mesh)") for m in warnings), warnings
+
+
+def test_an_animation_renders_every_frame_with_depth(addon, tmp_path):
+    scene, _ = build_scene()
+    scene.render.engine = "CIRRUS"
+    scene.render.resolution_x = scene.render.resolution_y = 16
+    scene.cirrus.spp = 2
+    scene.view_layers[0].use_pass_z = True
+    scene.frame_start, scene.frame_end = 1, 2
+    scene.render.filepath = str(tmp_path / "anim_####")
+    scene.render.image_settings.exr_codec = "ZIP"
+    scene.render.image_settings.use_preview = False
+    bpy.ops.render.render(animation=True)
+    frames = sorted(p.name for p in tmp_path.glob("anim_*.exr"))
+    assert frames == ["anim_0001.exr", "anim_0002.exr"], frames
+    img = bpy.data.images.load(str(tmp_path / "anim_0001.exr"))
+    px = np.array(img.pixels[:]).reshape(16, 16, 4)
+    assert px[..., 3].max() > 0.0, "the cloud covers some pixels"
