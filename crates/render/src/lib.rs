@@ -40,6 +40,7 @@
 pub mod adaptive;
 pub mod blackbody;
 pub mod camera;
+pub mod compositing;
 pub mod control;
 pub mod distribution;
 pub mod env_map;
@@ -64,6 +65,7 @@ pub mod volumes;
 pub use adaptive::Adaptive;
 pub use blackbody::Blackbody;
 pub use camera::Camera;
+pub use compositing::{Compositing, DepthHoldout, Layers, LightGroup};
 pub use control::RenderControl;
 pub use env_map::EnvMap;
 pub use film::{AovImage, Image};

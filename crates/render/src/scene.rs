@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::adaptive::Adaptive;
 use crate::camera::Camera;
+use crate::compositing::Compositing;
 use crate::control::RenderControl;
 use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::light::Lights;
@@ -103,6 +104,9 @@ pub struct RenderSettings {
     /// moving media must have been built for the same shutter, so their
     /// majorants bound every time drawn.
     pub shutter: Shutter,
+    /// Light groups, holdout depth, Cryptomatte and deep samples
+    /// ([`crate::compositing`]); the default keeps none.
+    pub compositing: Compositing,
 }
 
 /// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
@@ -147,6 +151,7 @@ impl Default for RenderSettings {
             aovs: false,
             control: None,
             shutter: Shutter::INSTANT,
+            compositing: Compositing::default(),
         }
     }
 }
@@ -193,6 +198,7 @@ impl RenderSettings {
         if let Some(a) = &self.adaptive {
             a.validate()?;
         }
+        self.compositing.validate()?;
         Ok(())
     }
 }

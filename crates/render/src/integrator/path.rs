@@ -2,7 +2,8 @@
 
 use glam::Vec3;
 
-use super::{escaped_radiance, AovSample, CameraSampler, Sample};
+use super::{escaped_radiance, AovSample, CameraSampler, LightParts, Sample};
+use crate::compositing::{tag, GroupRadiance, LightGroup};
 use crate::light::{LightSample, Lights};
 use crate::medium::Media;
 use crate::phase::Phase;
@@ -97,9 +98,9 @@ impl<'a, M: Media> PathTracer<'a, M> {
         c: &mut Counters,
     ) -> FreeFlight {
         if self.chromatic {
-            sample_free_flight_spectral(self.medium, ray, f32::INFINITY, beta, rng, c)
+            sample_free_flight_spectral(self.medium, ray, ray.t_max, beta, rng, c)
         } else {
-            sample_free_flight(self.medium, ray, f32::INFINITY, rng, c)
+            sample_free_flight(self.medium, ray, ray.t_max, rng, c)
         }
     }
 
@@ -132,14 +133,14 @@ impl<'a, M: Media> PathTracer<'a, M> {
         vertex: u32,
         draws: &mut SampleStream,
         c: &mut Counters,
-    ) -> Vec3 {
-        let mut l = Vec3::ZERO;
+    ) -> LightParts {
+        let mut l = LightParts::default();
         if let Some(sun) = &self.lights.sun {
             let (u1, u2) = draws.get_2d(Draw::SunDirection, vertex);
             let s = sun.sample(u1, u2);
             c.nee_rays_sun += 1;
             let shadow = (Draw::SunShadow, vertex);
-            l += self.light_term(p, ray_in, phase, s, mis, shadow, draws, c);
+            l.sun = self.light_term(p, ray_in, phase, s, mis, shadow, draws, c);
         }
         if let Some(env) = &self.lights.environment {
             let (u1, u2) = draws.get_2d(Draw::SkyDirection, vertex);
@@ -148,7 +149,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             // A zero-density sample (a pole) is dropped without a shadow ray.
             c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
             let shadow = (Draw::SkyShadow, vertex);
-            l += self.light_term(p, ray_in, phase, s, mis, shadow, draws, c);
+            l.sky = self.light_term(p, ray_in, phase, s, mis, shadow, draws, c);
         }
         l
     }
@@ -203,6 +204,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
         let mut l = Vec3::ZERO;
         let mut alpha = 0.0;
         let mut aov = AovSample::default();
+        let mut groups = GroupRadiance::default();
         let mut depth = 0u32;
         let mut phase_pdf = None;
         // Set after the last allowed scattering event when the media emit:
@@ -225,8 +227,13 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             }
             let t = match flight {
                 FreeFlight::Escaped if emission_only => break,
+                // A camera ray ended by a depth holdout: what lies behind
+                // the held-out geometry, the sky included, never shows.
+                FreeFlight::Escaped if ray.t_max.is_finite() => break,
                 FreeFlight::Escaped => {
-                    let e = beta * escaped_radiance(&self.lights, ray.dir, phase_pdf, c);
+                    let parts = escaped_radiance(&self.lights, ray.dir, phase_pdf, c);
+                    let e = beta * parts.total();
+                    parts.scaled(beta).tag(&mut groups);
                     l += e;
                     if depth == 1 {
                         aov.direct += e;
@@ -242,8 +249,14 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 beta *= it.weight;
             }
             if depth == 0 {
+                // A holdout volume seen first is a matte: no light, no alpha.
+                if self.medium.holdout(it.instance) {
+                    alpha = 0.0;
+                    break;
+                }
                 aov.albedo = it.albedo;
                 aov.depth = Some(t);
+                aov.instance = Some(it.instance);
             }
             if emits {
                 let e = beta
@@ -251,6 +264,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                     * self.medium.emission_at(p, ray.time, it.instance, c);
                 l += e;
                 aov.emission += e;
+                tag(&mut groups, LightGroup::Emission, e);
             }
             if self.max_depth == Some(depth) {
                 break;
@@ -261,7 +275,9 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 break;
             }
             let last = self.max_depth == Some(depth);
-            let direct = beta * self.direct_light(p, &ray, it.phase, !last, vertex, draws, c);
+            let parts = self.direct_light(p, &ray, it.phase, !last, vertex, draws, c);
+            let direct = beta * parts.total();
+            parts.scaled(beta).tag(&mut groups);
             l += direct;
             if depth == 1 {
                 aov.direct += direct;
@@ -290,6 +306,7 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             radiance: l,
             alpha,
             aov,
+            groups,
         }
     }
 }

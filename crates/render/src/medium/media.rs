@@ -132,6 +132,13 @@ pub trait Media: Send + Sync {
         false
     }
 
+    /// Whether `instance` is a holdout: it shadows and lights the others
+    /// as before, but a camera path that meets it first shows nothing.
+    #[inline]
+    fn holdout(&self, _instance: u32) -> bool {
+        false
+    }
+
     /// Emitted radiance `Le` of `instance` at `p` (the source term of the
     /// radiative transfer equation is `sigma_a * Le`); counts its lookups.
     fn emission(&self, _p: Vec3, _instance: u32, _c: &mut Counters) -> Vec3 {
@@ -310,6 +317,9 @@ impl<M: Media> Media for GlobalMedia<'_, M> {
     }
     fn emits(&self) -> bool {
         self.inner.emits()
+    }
+    fn holdout(&self, instance: u32) -> bool {
+        self.inner.holdout(instance)
     }
     fn emission(&self, p: Vec3, instance: u32, c: &mut Counters) -> Vec3 {
         self.inner.emission(p, instance, c)

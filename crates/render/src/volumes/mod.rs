@@ -78,6 +78,8 @@ pub struct VolumeInstance<F> {
     pub albedo: Vec3,
     pub phase: Phase,
     pub emission: Option<Emission<F>>,
+    /// A matte: lights and shadows the others, never seen by the camera.
+    pub holdout: bool,
 }
 
 impl<F: DensityField> VolumeInstance<F> {
@@ -91,6 +93,7 @@ impl<F: DensityField> VolumeInstance<F> {
             albedo,
             phase: Phase::hg(g),
             emission: None,
+            holdout: false,
         }
     }
 
@@ -338,6 +341,11 @@ impl<F: DensityField> Media for Volumes<F> {
 
     fn emits(&self) -> bool {
         self.emits
+    }
+
+    #[inline]
+    fn holdout(&self, instance: u32) -> bool {
+        self.instances[instance as usize].holdout
     }
 
     #[inline]
