@@ -11,6 +11,9 @@
 //! the library renames over the destination once it is complete.
 
 mod ffi;
+mod merge;
+
+pub use merge::{is_deep_file, merge};
 
 use std::ffi::{CStr, CString};
 use std::io;

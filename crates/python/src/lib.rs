@@ -149,6 +149,8 @@ fn render<'py>(
             })
             .collect(),
     };
+    let mut aovs = aovs;
+    aovs.extend(group_layers(py, &rendered));
     Ok((
         rgba,
         image.width,
@@ -156,6 +158,23 @@ fn render<'py>(
         rendered.stats.to_json(),
         aovs,
     ))
+}
+
+/// The light-group layers of a render, as AOV layers (name, 3, RGB bytes).
+fn group_layers<'py>(
+    py: Python<'py>,
+    rendered: &Rendered,
+) -> Vec<(String, usize, Bound<'py, PyBytes>)> {
+    let Some(layers) = &rendered.layers else {
+        return Vec::new();
+    };
+    let names = layers.group_names.iter().zip(&layers.groups);
+    names
+        .map(|(name, values)| {
+            let bytes = f32_bytes(values.iter().flatten().copied());
+            (name.clone(), 3, PyBytes::new(py, &bytes))
+        })
+        .collect()
 }
 
 /// Runs the render on its own thread and waits with the GIL released,

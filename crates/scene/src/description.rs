@@ -47,6 +47,16 @@ pub struct OutputSpec {
     pub aov: Option<Vec<Aov>>,
     /// `[x0, y0, x1, y1]`, pixels, half-open.
     pub crop: Option<[u32; 4]>,
+    // Compositing (`--aov lights`, `--aov cryptomatte`, `--deep`, `--deep-samples`).
+    /// Light-group layers `sun`, `sky`, `emission`.
+    pub light_groups: Option<bool>,
+    /// `CryptoObject` and `CryptoAsset` layers.
+    pub cryptomatte: Option<bool>,
+    /// A deep scanline EXR of the camera rays' volumetric samples.
+    pub deep: Option<PathBuf>,
+    /// At most this many deep samples per pixel (plus the background).
+    pub deep_samples: Option<u32>,
+    // End of compositing.
 }
 
 /// `--spp`, `--time`, `--seed`, `--integrator`, `--transmittance`,
@@ -81,6 +91,13 @@ pub struct RenderSpec {
     /// `[open, close]` in frames around the frame (`--shutter`): motion
     /// blur from the volumes' velocity grids.
     pub shutter: Option<[f32; 2]>,
+    // Compositing (`--holdout-depth`, `--holdout-far`).
+    /// `"FILE.exr[:CHANNEL]"`: a camera-space (planar) depth image where
+    /// camera rays end, relative to the scene file.
+    pub holdout_depth: Option<String>,
+    /// Depths at or beyond this are no depth (default 1e10).
+    pub holdout_far: Option<f32>,
+    // End of compositing.
 }
 
 /// `--res`, `--camera-from`, `--camera-to`, `--camera-up`, `--fov`.
@@ -159,6 +176,13 @@ impl std::fmt::Display for Colour {
 pub struct VolumeSpec {
     /// A .vdb, .nvdb or .cbrk file, relative to the scene file.
     pub file: PathBuf,
+    // Compositing.
+    /// The instance's name in the Cryptomatte manifest (default: the
+    /// file's stem, made unique with `_2`, `_3`, ...).
+    pub name: Option<String>,
+    /// A matte: lights and shadows the other volumes, never seen.
+    pub holdout: Option<bool>,
+    // End of compositing.
     /// Density grid name (default "density", else the first float grid).
     pub density: Option<String>,
     /// Temperature grid name: blackbody emission (see `blackbody`).
@@ -279,6 +303,11 @@ impl SceneDescription {
         if let Some(map) = self.environment.as_mut().and_then(|e| e.map.as_mut()) {
             *map = dir.join(&*map);
         }
+        if let Some(spec) = self.render.holdout_depth.as_mut() {
+            let (file, channel) = crate::compositing::split_depth_spec(spec);
+            let file = dir.join(file).display().to_string();
+            *spec = channel.map_or(file.clone(), |c| format!("{file}:{c}"));
+        }
     }
 
     /// Every input and output path with its frame pattern replaced by `frame`.
@@ -291,8 +320,16 @@ impl SceneDescription {
             *map = substitute(map, frame);
         }
         let o = &mut self.output;
-        for path in [&mut o.exr, &mut o.png, &mut o.stats].into_iter().flatten() {
+        for path in [&mut o.exr, &mut o.png, &mut o.stats, &mut o.deep]
+            .into_iter()
+            .flatten()
+        {
             *path = substitute(path, frame);
+        }
+        if let Some(spec) = self.render.holdout_depth.as_mut() {
+            *spec = substitute(Path::new(spec.as_str()), frame)
+                .display()
+                .to_string();
         }
     }
 

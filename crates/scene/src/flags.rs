@@ -167,6 +167,18 @@ pub struct SceneFlags {
     /// AOV); the EXR keeps the noisy image as `noisy.R/G/B`.
     #[arg(long)]
     pub denoise: bool,
+    // Compositing.
+    /// A camera-space depth image (planar depth, as Blender's Z pass) of
+    /// the same camera and size, FILE.exr[:CHANNEL]: camera rays end there,
+    /// so the cloud renders behind geometry it was never given
+    /// [default channel: Z, or the one ending in .Z].
+    #[arg(long)]
+    pub holdout_depth: Option<String>,
+    /// Depths at or beyond this are no depth [default: 1e10, Blender's
+    /// background].
+    #[arg(long)]
+    pub holdout_far: Option<f32>,
+    // End of compositing.
 }
 
 /// Where the image goes.
@@ -192,6 +204,16 @@ pub struct OutputFlags {
     /// a data window (merge tiles with `cirrus merge`).
     #[arg(long, value_parser = parse::crop)]
     pub crop: Option<Crop>,
+    // Compositing.
+    /// Write a deep scanline EXR (Z, ZBack, R, G, B, A) of the camera rays'
+    /// volumetric samples.
+    #[arg(long)]
+    pub deep: Option<PathBuf>,
+    /// Deep samples per pixel at most, merged by optical depth (plus one
+    /// for the background) [default: 16].
+    #[arg(long)]
+    pub deep_samples: Option<u32>,
+    // End of compositing.
 }
 
 impl SceneFlags {
@@ -238,6 +260,8 @@ impl SceneFlags {
             env_map: self.env_map.clone(),
             env_rotation: self.env_rotation,
             env_intensity: self.env_intensity,
+            holdout_depth: self.holdout_depth.clone(),
+            holdout_far: self.holdout_far,
             ..Default::default()
         }
     }
@@ -252,5 +276,7 @@ impl OutputFlags {
         o.stats = self.stats.clone();
         o.aov = (!self.aov.is_empty()).then(|| self.aov.clone());
         o.crop = self.crop;
+        o.deep = self.deep.clone();
+        o.deep_samples = self.deep_samples;
     }
 }

@@ -32,6 +32,7 @@
 //! # Ok::<(), cirrus_scene::Error>(())
 //! ```
 
+pub mod compositing;
 pub mod cull;
 pub mod defaults;
 mod denoise;

@@ -76,6 +76,15 @@ pub struct Overrides {
     pub aov: Option<Vec<Aov>>,
     #[serde(default, deserialize_with = "crop")]
     pub crop: Option<Crop>,
+    // Compositing.
+    pub light_groups: Option<bool>,
+    pub cryptomatte: Option<bool>,
+    pub deep: Option<PathBuf>,
+    pub deep_samples: Option<u32>,
+    /// `FILE.exr[:CHANNEL]`, relative to the working directory.
+    pub holdout_depth: Option<String>,
+    pub holdout_far: Option<f32>,
+    // End of compositing.
 }
 
 fn resolution<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(u32, u32)>, D::Error> {
@@ -170,6 +179,14 @@ impl Overrides {
         set(&mut o.stats, self.stats.clone());
         set(&mut o.aov, self.aov.clone());
         set(&mut o.crop, self.crop.map(|c| [c.x0, c.y0, c.x1, c.y1]));
+        // Compositing.
+        set(&mut o.light_groups, self.light_groups);
+        set(&mut o.cryptomatte, self.cryptomatte);
+        set(&mut o.deep, self.deep.clone());
+        set(&mut o.deep_samples, self.deep_samples);
+        set(&mut d.render.holdout_depth, self.holdout_depth.clone());
+        set(&mut d.render.holdout_far, self.holdout_far);
+        // End of compositing.
     }
 }
 

@@ -41,6 +41,8 @@ pub struct Plan {
     phase: Phase,
     blackbody: Blackbody,
     emission_colour: Vec3,
+    /// A matte (compositing).
+    holdout: bool,
 }
 
 impl Plan {
@@ -148,6 +150,7 @@ pub fn plan(v: &VolumeSpec, files: &mut Files, moving: bool) -> Result<Plan> {
         },
         emission_colour: Vec3::from_array(v.emission_color.unwrap_or([1.0; 3]))
             * v.emission_scale.unwrap_or(1.0),
+        holdout: v.holdout.unwrap_or(false),
     })
 }
 
@@ -316,6 +319,7 @@ impl Files {
         let mut inst = VolumeInstance::new(density, extinction.scale, p.albedo, d::G)
             .with_phase(p.phase.clone())
             .with_extinction_tint(extinction.tint);
+        inst.holdout = p.holdout;
         if p.emits() {
             inst.emission = Some(cirrus_render::Emission {
                 temperature: p

@@ -128,6 +128,8 @@ impl Scene {
             if let Some(c) = &outputs.crop {
                 c.validate(res.0, res.1)?;
             }
+            crate::compositing::instance_names(&self.description)?;
+            crate::compositing::configure(settings, &outputs, &self.description, res)?;
             Ok(())
         };
         let mut rendered = if self.lone {
@@ -385,6 +387,8 @@ fn render_file(
     integrator_supports(&volumes, &settings.render)?;
     let load_seconds = start.elapsed().as_secs_f64();
     let mut rendered = render_media(&volumes, &camera, &settings.lights, &settings.render);
+    let kept: Vec<usize> = (0..keep.len()).filter(|&i| keep[i]).collect();
+    crate::compositing::renumber_instances(&mut rendered, &kept);
     rendered.stats.bytes_read = files.bytes_read();
     rendered.stats.grids_loaded = files.grids_loaded();
     rendered.stats.volumes_culled = keep.iter().filter(|k| !**k).count() as u64;
