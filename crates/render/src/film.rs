@@ -142,8 +142,10 @@ impl Tile {
     /// Adds one sample to the pixel at `(x, y)` (tile-local), replacing a
     /// non-finite sample by zero and counting it: a NaN must never reach
     /// the image, and dropping the sample instead would bias the mean.
+    /// `view_cos`: the cosine of its camera ray to the view axis (deep
+    /// samples store planar depth).
     #[inline]
-    pub fn add(&mut self, x: u32, y: u32, s: Sample, c: &mut Counters) {
+    pub fn add(&mut self, x: u32, y: u32, s: Sample, view_cos: f32, c: &mut Counters) {
         let v = [s.radiance.x, s.radiance.y, s.radiance.z, s.alpha];
         let finite = v.iter().all(|x| x.is_finite());
         let v = if finite {
@@ -154,7 +156,7 @@ impl Tile {
         };
         let i = (y * self.w + x) as usize;
         self.pixels[i].add(v);
-        self.layers.add(i, &s, finite);
+        self.layers.add(i, &s, finite, view_cos);
         if let Some(a) = self.aovs.get_mut(i) {
             let finite =
                 s.aov.albedo.is_finite() && s.aov.emission.is_finite() && s.aov.direct.is_finite();

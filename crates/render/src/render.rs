@@ -377,7 +377,7 @@ impl<S: CameraSampler> Passes<'_, S> {
                 None => ray,
             };
             let sample = self.sampler.sample_stream(ray, &mut draws, c);
-            tile.add(tx, ty, sample, c);
+            tile.add(tx, ty, sample, ray.dir.dot(self.camera.forward()), c);
             if rule.is_some_and(|r| r.is_checkpoint(s + 1) && r.converged(&tile.pixels[i])) {
                 tile.stopped[i] = true;
                 return u64::from(s + 1 - s0);

@@ -1,5 +1,8 @@
 //! Deep samples from the path tracer's own estimates.
 //!
+//! Depth is planar (along the view axis, as camera-space Z in Nuke and as
+//! `--holdout-depth` reads it), not distance along the ray.
+//!
 //! Each camera sample of a pixel either collides first at a depth `t` (it
 //! is opaque there: the track-length estimate of alpha is 1) or escapes
 //! (alpha 0), and carries its whole path's radiance `L`. The pixel keeps

@@ -41,9 +41,10 @@ impl TileLayers {
     }
 
     /// Adds pixel `i`'s sample `s`; `finite`: whether the film kept its
-    /// beauty (a non-finite sample counts as zero everywhere).
+    /// beauty (a non-finite sample counts as zero everywhere); `view_cos`
+    /// turns its distance along the camera ray into planar depth.
     #[inline]
-    pub fn add(&mut self, i: usize, s: &Sample, finite: bool) {
+    pub fn add(&mut self, i: usize, s: &Sample, finite: bool, view_cos: f32) {
         if self.groups > 0 {
             let groups = &s.groups[..self.groups];
             let ok = finite && groups.iter().all(|g| g.is_finite());
@@ -62,7 +63,7 @@ impl TileLayers {
         }
         if let Some(deep) = self.deep.get_mut(i) {
             let l = if finite { s.radiance } else { Vec3::ZERO };
-            deep.add(visible.and(s.aov.depth), l);
+            deep.add(visible.and(s.aov.depth).map(|t| t * view_cos), l);
         }
     }
 }
