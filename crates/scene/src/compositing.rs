@@ -308,3 +308,60 @@ pub(crate) fn denoise_groups(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_come_from_files_made_unique_and_clashes_are_refused() {
+        let d = SceneDescription::parse(
+            "[[volume]]\nfile = \"a/cloud.0001.vdb\"\n[[volume]]\nfile = \"b/cloud.vdb\"\n\
+             [[volume]]\nfile = \"c.vdb\"\nname = \"cloud_2\"\n[[volume]]\nfile = \"fire.vdb\"\n",
+        )
+        .unwrap();
+        assert_eq!(
+            instance_names(&d).unwrap(),
+            ["cloud", "cloud_3", "cloud_2", "fire"]
+        );
+        assert_eq!(
+            asset_names(&d),
+            ["cloud.0001.vdb", "cloud.vdb", "c.vdb", "fire.vdb"]
+        );
+        let d = SceneDescription::parse(
+            "[[volume]]\nfile = \"a.vdb\"\nname = \"x\"\n[[volume]]\nfile = \"b.vdb\"\nname = \"x\"\n",
+        )
+        .unwrap();
+        let e = instance_names(&d).unwrap_err().to_string();
+        assert!(e.contains("\"x\""), "{e}");
+    }
+
+    #[test]
+    fn light_groups_may_not_take_another_layers_name() {
+        for bad in ["albedo", "CryptoObject", "A"] {
+            let e = check_group_names(&[bad.to_string()])
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(bad) && e.contains("clashes"), "{e}");
+        }
+        assert!(check_group_names(&["sun".into(), "emission".into()]).is_ok());
+        let twice = cirrus_render::Compositing {
+            light_groups: vec!["key".into(), "key".into()],
+            ..Default::default()
+        };
+        assert!(twice
+            .validate()
+            .unwrap_err()
+            .contains("\"key\" is named twice"));
+    }
+
+    #[test]
+    fn a_depth_spec_splits_at_its_channel() {
+        assert_eq!(split_depth_spec("z.exr"), (PathBuf::from("z.exr"), None));
+        let (f, c) = split_depth_spec("dir/z.exr:ViewLayer.Depth.Z");
+        assert_eq!(
+            (f, c.as_deref()),
+            (PathBuf::from("dir/z.exr"), Some("ViewLayer.Depth.Z"))
+        );
+    }
+}

@@ -84,6 +84,7 @@ impl Scene {
             return Err(Error::input("no [[volume]] in the scene"));
         }
         description.rebase(dir);
+        crate::compositing::instance_names(&description)?;
         Ok(Scene {
             description,
             lone: false,
@@ -128,7 +129,6 @@ impl Scene {
             if let Some(c) = &outputs.crop {
                 c.validate(res.0, res.1)?;
             }
-            crate::compositing::instance_names(&self.description)?;
             crate::compositing::configure(settings, &outputs, &self.description, res)?;
             Ok(())
         };
