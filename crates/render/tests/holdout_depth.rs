@@ -182,6 +182,14 @@ fn a_depth_holdout_is_the_density_cut_at_its_plane() {
         alpha(&held) < 0.9 * alpha(&whole),
         "the plane must cut the cloud"
     );
+    let largest = held
+        .image
+        .rgba
+        .iter()
+        .zip(&reference.image.rgba)
+        .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
+    eprintln!("largest difference from the cut density: {largest:e}");
     for c in 0..4 {
         let d = common::differences(&held.image, &reference.image, c);
         common::assert_pooled_agreement(&format!("channel {c}"), &d);
