@@ -97,7 +97,8 @@ fn render_with<M: Media>(
     let lights = lights.clone();
     let (image, aovs, layers, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
-            let s = PathTracer::new(medium, lights, settings.transmittance, settings.max_depth);
+            let s = PathTracer::new(medium, lights, settings.transmittance, settings.max_depth)
+                .with_light_groups(!settings.compositing.light_groups.is_empty());
             let (image, aovs, layers) = run(&s, camera, settings, start, &mut counters);
             (image, aovs, layers, 0.0)
         }

@@ -69,6 +69,9 @@ pub struct PathTracer<'a, M> {
     estimator: TransmittanceEstimator,
     max_depth: Option<u32>,
     chromatic: bool,
+    /// Tag contributions with their light groups (off: `Sample::groups`
+    /// stays zero and costs nothing).
+    light_groups: bool,
 }
 
 impl<'a, M: Media> PathTracer<'a, M> {
@@ -84,6 +87,15 @@ impl<'a, M: Media> PathTracer<'a, M> {
             estimator,
             max_depth,
             chromatic: medium.chromatic(),
+            light_groups: false,
+        }
+    }
+
+    /// Splits each sample's radiance into light groups as well.
+    pub fn with_light_groups(self, light_groups: bool) -> Self {
+        Self {
+            light_groups,
+            ..self
         }
     }
 
@@ -233,7 +245,9 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                 FreeFlight::Escaped => {
                     let parts = escaped_radiance(&self.lights, ray.dir, phase_pdf, c);
                     let e = beta * parts.total();
-                    parts.scaled(beta).tag(&mut groups);
+                    if self.light_groups {
+                        parts.scaled(beta).tag(&mut groups);
+                    }
                     l += e;
                     if depth == 1 {
                         aov.direct += e;
@@ -264,7 +278,9 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
                     * self.medium.emission_at(p, ray.time, it.instance, c);
                 l += e;
                 aov.emission += e;
-                tag(&mut groups, LightGroup::Emission, e);
+                if self.light_groups {
+                    tag(&mut groups, LightGroup::Emission, e);
+                }
             }
             if self.max_depth == Some(depth) {
                 break;
@@ -277,7 +293,9 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             let last = self.max_depth == Some(depth);
             let parts = self.direct_light(p, &ray, it.phase, !last, vertex, draws, c);
             let direct = beta * parts.total();
-            parts.scaled(beta).tag(&mut groups);
+            if self.light_groups {
+                parts.scaled(beta).tag(&mut groups);
+            }
             l += direct;
             if depth == 1 {
                 aov.direct += direct;
