@@ -287,3 +287,25 @@ fn a_deep_holdout_is_the_depth_holdout() {
         common::assert_pooled_agreement(&format!("deep cut channel {c}"), &d);
     }
 }
+
+/// Every layer is the same on one thread as on three.
+#[test]
+fn layers_do_not_depend_on_the_thread_count() {
+    let mut s = settings(IntegratorKind::Path, 8);
+    s.compositing.cryptomatte = true;
+    s.compositing.deep_samples = Some(4);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| render_media(&volumes(true), &camera(), &lights(true, true), &s))
+    };
+    let (one, three) = (run(1), run(3));
+    assert_eq!(one.image, three.image);
+    assert_eq!(one.layers, three.layers);
+    let layers = one.layers.unwrap();
+    assert!(
+        layers.deep.iter().any(|p| p.len() > 1) && layers.coverage.iter().any(|p| p.len() == 2)
+    );
+}
