@@ -468,6 +468,8 @@ fn channel_names(ctx: &Context) -> Result<Vec<String>, String> {
     if !(1..=64).contains(&list.num_channels) || list.entries.is_null() {
         return Err(format!("{} channels", list.num_channels));
     }
+    // SAFETY: `entries` is non-null and holds `num_channels` (1 to 64)
+    // entries owned by the header, alive while the context is open.
     let entries = unsafe { std::slice::from_raw_parts(list.entries, list.num_channels as usize) };
     entries
         .iter()

@@ -186,12 +186,14 @@ pub(crate) fn written_aovs(outputs: &Outputs, layers: Option<&Layers>) -> Vec<Ao
         .collect()
 }
 
+/// Named f32 channels of an EXR layer set.
+type Channels = Vec<(String, Vec<f32>)>;
+/// Header text attributes, by name.
+type Attributes = Vec<(String, String)>;
+
 /// The light-group and Cryptomatte channels of a render, with the
 /// Cryptomatte header attributes.
-pub(crate) fn layer_channels(
-    r: &Rendered,
-    outputs: &Outputs,
-) -> (Vec<(String, Vec<f32>)>, Vec<(String, String)>) {
+pub(crate) fn layer_channels(r: &Rendered, outputs: &Outputs) -> (Channels, Attributes) {
     let (mut channels, mut attributes) = (Vec::new(), Vec::new());
     let Some(layers) = &r.layers else {
         return (channels, attributes);

@@ -169,8 +169,8 @@ pub fn flatten(samples: &[DeepSample]) -> [f32; 4] {
     let mut out = [0.0f64; 4];
     let mut t = 1.0f64;
     for s in samples {
-        for c in 0..3 {
-            out[c] += t * f64::from(s.rgb[c]);
+        for (o, c) in out.iter_mut().zip(s.rgb) {
+            *o += t * f64::from(c);
         }
         out[3] += t * f64::from(s.alpha);
         t *= 1.0 - f64::from(s.alpha);
