@@ -8,7 +8,7 @@ python=${1:-python3}
 venv=target/venv
 [ -x "$venv/bin/python" ] || "$python" -m venv "$venv"
 "$venv/bin/python" -m pip install -q --upgrade pip
-"$venv/bin/python" -m pip install -q "maturin>=1.9,<2" numpy pytest "OpenEXR>=3.2" usd-core
+"$venv/bin/python" -m pip install -q "maturin>=1.9,<2" numpy pytest "OpenEXR>=3.5" mmh3 usd-core
 VIRTUAL_ENV="$PWD/$venv" PATH="$PWD/$venv/bin:$PATH" \
   "$venv/bin/maturin" develop --release -q -m crates/python/Cargo.toml
 [ -x target/release/cirrus ] || cargo build --release -p cirrus-cli

@@ -254,6 +254,7 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
                 albedo: m.albedo,
                 phase: m.phase,
                 emission: None,
+                holdout: m.holdout,
             })
             .collect();
         Scene {

@@ -125,6 +125,7 @@ mod tests {
             },
             aovs: None,
             noisy: None,
+            layers: None,
         }
     }
 

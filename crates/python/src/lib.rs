@@ -154,7 +154,26 @@ fn render<'py>(
     let mut stats: serde_json::Value = serde_json::from_str(&rendered.stats.to_json())
         .map_err(|e| PyValueError::new_err(format!("stats: {e}")))?;
     stats["warnings"] = serde_json::json!(scene.warnings());
+    let mut aovs = aovs;
+    aovs.extend(group_layers(py, &rendered));
     Ok((rgba, image.width, image.height, stats.to_string(), aovs))
+}
+
+/// The light-group layers of a render, as AOV layers (name, 3, RGB bytes).
+fn group_layers<'py>(
+    py: Python<'py>,
+    rendered: &Rendered,
+) -> Vec<(String, usize, Bound<'py, PyBytes>)> {
+    let Some(layers) = &rendered.layers else {
+        return Vec::new();
+    };
+    let names = layers.group_names.iter().zip(&layers.groups);
+    names
+        .map(|(name, values)| {
+            let bytes = f32_bytes(values.iter().flatten().copied());
+            (name.clone(), 3, PyBytes::new(py, &bytes))
+        })
+        .collect()
 }
 
 /// Runs the render on its own thread and waits with the GIL released,

@@ -115,6 +115,10 @@ impl Camera {
     pub fn up(&self) -> Vec3 {
         self.up
     }
+    /// The unit view axis (depth holdouts measure depth along it).
+    pub fn forward(&self) -> Vec3 {
+        self.forward
+    }
     /// Vertical field of view in degrees.
     pub fn vfov_degrees(&self) -> f32 {
         self.vfov_degrees

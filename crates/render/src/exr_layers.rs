@@ -29,15 +29,21 @@ pub enum Aov {
     Emission,
     Direct,
     Samples,
+    /// Not an AOV of [`AovImage`]: asks for the light-group layers.
+    Lights,
+    /// Not an AOV of [`AovImage`]: asks for the Cryptomatte layers.
+    Cryptomatte,
 }
 
 impl Aov {
-    pub const ALL: [Aov; 5] = [
+    pub const ALL: [Aov; 7] = [
         Aov::Albedo,
         Aov::Depth,
         Aov::Emission,
         Aov::Direct,
         Aov::Samples,
+        Aov::Lights,
+        Aov::Cryptomatte,
     ];
 
     pub fn name(self) -> &'static str {
@@ -47,6 +53,8 @@ impl Aov {
             Aov::Emission => "emission",
             Aov::Direct => "direct",
             Aov::Samples => "samples",
+            Aov::Lights => "lights",
+            Aov::Cryptomatte => "cryptomatte",
         }
     }
 
@@ -56,7 +64,8 @@ impl Aov {
             .find(|a| a.name() == s.trim())
             .ok_or_else(|| {
                 Error::invalid(format!(
-                    "unknown AOV {s:?} (known: albedo, depth, emission, direct, samples)"
+                    "unknown AOV {s:?} (known: albedo, depth, emission, direct, samples, \
+                     lights, cryptomatte)"
                 ))
             })
     }
@@ -76,6 +85,8 @@ impl Aov {
             Aov::Direct => rgb("direct", &a.direct),
             Aov::Depth => vec![("depth.Z".into(), a.depth.clone())],
             Aov::Samples => vec![("samples.Y".into(), a.samples.clone())],
+            // Written from the render's compositing layers instead.
+            Aov::Lights | Aov::Cryptomatte => Vec::new(),
         }
     }
 }
@@ -83,6 +94,18 @@ impl Aov {
 /// Writes a render as EXR: RGBA plus the requested AOV layers, in a data
 /// window when it is a crop. Atomic like every image written here.
 pub fn write_exr_layers(path: &Path, r: &Rendered, aovs: &[Aov]) -> std::io::Result<()> {
+    write_exr_with(path, r, aovs, Vec::new(), Vec::new())
+}
+
+/// [`write_exr_layers`] with `extra` channels after the AOVs (light groups,
+/// Cryptomatte) and string attributes for the header.
+pub fn write_exr_with(
+    path: &Path,
+    r: &Rendered,
+    aovs: &[Aov],
+    extra: Vec<(String, Vec<f32>)>,
+    attributes: Vec<(String, String)>,
+) -> std::io::Result<()> {
     let img = &r.image;
     let mut channels: Vec<(String, Vec<f32>)> = ["R", "G", "B", "A"]
         .iter()
@@ -103,6 +126,7 @@ pub fn write_exr_layers(path: &Path, r: &Rendered, aovs: &[Aov]) -> std::io::Res
             channels.push((n.to_string(), noisy.iter().map(|p| p[c]).collect()));
         }
     }
+    channels.extend(extra);
     let w = &r.window;
     write_channels(
         path,
@@ -110,6 +134,7 @@ pub fn write_exr_layers(path: &Path, r: &Rendered, aovs: &[Aov]) -> std::io::Res
         (w.x0 as i32, w.y0 as i32),
         (img.width as usize, img.height as usize),
         channels,
+        attributes,
     )
 }
 
@@ -121,19 +146,30 @@ fn write_channels(
     position: (i32, i32),
     size: (usize, usize),
     channels: Vec<(String, Vec<f32>)>,
+    attributes: Vec<(String, String)>,
 ) -> std::io::Result<()> {
     use exr::prelude::*;
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
         .into_iter()
         .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v)))
         .collect();
-    let attributes = LayerAttributes {
+    let mut layer_attributes = LayerAttributes {
         layer_position: Vec2(position.0, position.1),
         ..LayerAttributes::default()
     };
+    for (name, value) in attributes {
+        let text = |s: &str| {
+            Text::new_or_none(s).ok_or_else(|| {
+                std::io::Error::other(format!("attribute {name}: not storable as EXR text"))
+            })
+        };
+        layer_attributes
+            .other
+            .insert(text(&name)?, AttributeValue::Text(text(&value)?));
+    }
     let layer = Layer::new(
         Vec2(size.0, size.1),
-        attributes,
+        layer_attributes,
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(list),
     );
@@ -155,6 +191,8 @@ struct Tile {
     position: (i32, i32),
     size: (usize, usize),
     channels: Vec<(String, Vec<f32>)>,
+    /// The header's text attributes (the Cryptomatte manifest), sorted.
+    attributes: Vec<(String, String)>,
 }
 
 fn read_tile(path: &Path) -> Result<Tile> {
@@ -169,13 +207,24 @@ fn read_tile(path: &Path) -> Result<Tile> {
         .from_file(path)
         .map_err(err)?;
     let dw = image.attributes.display_window;
+    let layer = image.layer_data;
+    // The exr crate reads a header's unknown attributes into the layer's.
+    let mut attributes: Vec<(String, String)> = layer
+        .attributes
+        .other
+        .iter()
+        .filter_map(|(k, v)| match v {
+            AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
+            _ => None,
+        })
+        .collect();
+    attributes.sort();
     if dw.position != Vec2(0, 0) {
         return Err(crate::error::Error::format(
             path,
             "display window must start at 0,0",
         ));
     }
-    let layer = image.layer_data;
     let channels = layer
         .channel_data
         .list
@@ -197,6 +246,7 @@ fn read_tile(path: &Path) -> Result<Tile> {
         ),
         size: (layer.size.0, layer.size.1),
         channels,
+        attributes,
     })
 }
 
@@ -210,12 +260,14 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
     let t0 = read_tile(first)?;
     let (fw, fh) = t0.full;
     let names: Vec<String> = t0.channels.iter().map(|(n, _)| n.clone()).collect();
+    let attributes = t0.attributes.clone();
     let mut data: Vec<Vec<f32>> = vec![vec![0.0; fw * fh]; names.len()];
     let mut covered = vec![false; fw * fh];
     for (k, path) in tiles.iter().enumerate() {
         let t = if k == 0 {
             Tile {
                 channels: t0.channels.clone(),
+                attributes: t0.attributes.clone(),
                 ..t0
             }
         } else {
@@ -231,6 +283,11 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
         let tile_names: Vec<&String> = t.channels.iter().map(|(n, _)| n).collect();
         if tile_names != names.iter().collect::<Vec<_>>() {
             return Err(misfit("channels differ from the first tile's".into()));
+        }
+        if t.attributes != attributes {
+            return Err(misfit(
+                "header attributes (the Cryptomatte manifest) differ from the first tile's".into(),
+            ));
         }
         let (x0, y0) = t.position;
         let (w, h) = t.size;
@@ -271,6 +328,7 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
         (0, 0),
         (fw, fh),
         names.into_iter().zip(data).collect(),
+        attributes,
     )
     .map_err(|e| Error::io(out, e))
 }
@@ -284,6 +342,7 @@ pub fn read_channels(path: &Path) -> Result<ExrChannels> {
         position: t.position,
         size: t.size,
         channels: t.channels,
+        attributes: t.attributes,
     })
 }
 
@@ -294,4 +353,6 @@ pub struct ExrChannels {
     pub position: (i32, i32),
     pub size: (usize, usize),
     pub channels: Vec<(String, Vec<f32>)>,
+    /// The header's text attributes, sorted by name.
+    pub attributes: Vec<(String, String)>,
 }

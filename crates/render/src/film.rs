@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use crate::compositing::{Compositing, Layers, TileLayers};
 use crate::integrator::{AovSample, Sample};
 use crate::stats::Counters;
 
@@ -133,16 +134,21 @@ pub(crate) struct Tile {
     pub stopped: Vec<bool>,
     /// Empty unless the render keeps AOVs.
     pub aovs: Vec<AovAccumulator>,
+    /// Light groups, coverage and deep bins, when kept.
+    pub layers: TileLayers,
 }
 
 impl Tile {
     /// Adds one sample to the pixel at `(x, y)` (tile-local), replacing a
     /// non-finite sample by zero and counting it: a NaN must never reach
     /// the image, and dropping the sample instead would bias the mean.
+    /// `view_cos`: the cosine of its camera ray to the view axis (deep
+    /// samples store planar depth).
     #[inline]
-    pub fn add(&mut self, x: u32, y: u32, s: Sample, c: &mut Counters) {
+    pub fn add(&mut self, x: u32, y: u32, s: Sample, view_cos: f32, c: &mut Counters) {
         let v = [s.radiance.x, s.radiance.y, s.radiance.z, s.alpha];
-        let v = if v.iter().all(|x| x.is_finite()) {
+        let finite = v.iter().all(|x| x.is_finite());
+        let v = if finite {
             v
         } else {
             c.nonfinite_samples += 1;
@@ -150,6 +156,7 @@ impl Tile {
         };
         let i = (y * self.w + x) as usize;
         self.pixels[i].add(v);
+        self.layers.add(i, &s, finite, view_cos);
         if let Some(a) = self.aovs.get_mut(i) {
             let finite =
                 s.aov.albedo.is_finite() && s.aov.emission.is_finite() && s.aov.direct.is_finite();
@@ -167,11 +174,18 @@ pub(crate) struct Film {
     pub height: u32,
     pub tiles: Vec<Tile>,
     pub aovs: bool,
+    pub compositing: Compositing,
 }
 
 impl Film {
-    /// Tiles of edge `tile` over the window; AOV accumulators if `aovs`.
-    pub fn new(x0: u32, y0: u32, width: u32, height: u32, tile: u32, aovs: bool) -> Self {
+    /// Tiles of edge `tile` over the window; AOV accumulators if `aovs`,
+    /// and the layers `compositing` asks for.
+    pub fn new(
+        (x0, y0, width, height): (u32, u32, u32, u32),
+        tile: u32,
+        aovs: bool,
+        compositing: &Compositing,
+    ) -> Self {
         let tile = tile.max(1);
         let mut tiles = Vec::new();
         for ty in (0..height).step_by(tile as usize) {
@@ -190,6 +204,7 @@ impl Film {
                     } else {
                         Vec::new()
                     },
+                    layers: TileLayers::new(compositing, n),
                 });
             }
         }
@@ -200,7 +215,26 @@ impl Film {
             height,
             tiles,
             aovs,
+            compositing: compositing.clone(),
         }
+    }
+
+    /// The compositing layers so far (`None` unless the film keeps any).
+    pub fn resolve_layers(&self) -> Option<Layers> {
+        if !self.compositing.keeps_layers() {
+            return None;
+        }
+        let tiles = self
+            .tiles
+            .iter()
+            .map(|t| (&t.layers, (t.x0, t.y0, t.w, t.h), t));
+        let window = (self.x0, self.y0, self.width, self.height);
+        Some(crate::compositing::film::resolve(
+            &self.compositing,
+            window,
+            tiles,
+            |t: &Tile, i| t.pixels[i].count(),
+        ))
     }
 
     /// The AOV passes so far (`None` unless the film keeps them).

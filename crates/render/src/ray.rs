@@ -14,6 +14,9 @@ pub struct Ray {
     pub origin: Vec3,
     pub dir: Vec3,
     pub time: f32,
+    /// Where the ray ends: infinity, except for a camera ray ending at a
+    /// holdout's depth. Rays spawned from it go on to infinity.
+    pub t_max: f32,
 }
 
 impl Ray {
@@ -23,6 +26,7 @@ impl Ray {
             origin,
             dir,
             time: 0.0,
+            t_max: f32::INFINITY,
         }
     }
 
@@ -40,7 +44,14 @@ impl Ray {
             origin,
             dir,
             time: self.time,
+            t_max: f32::INFINITY,
         }
+    }
+
+    /// The same ray ending at `t_max` (a holdout's depth).
+    #[inline]
+    pub fn with_t_max(self, t_max: f32) -> Self {
+        Self { t_max, ..self }
     }
 
     #[inline]

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use crate::adaptive::{Adaptive, Selection};
 use crate::camera::Camera;
+use crate::compositing::{DepthHoldout, Layers};
 use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Image, Tile};
 use crate::integrator::{
@@ -34,6 +35,8 @@ pub struct Rendered {
     /// The image's RGB before a denoiser replaced it (written as the
     /// `noisy.R/G/B` layer).
     pub noisy: Option<Vec<[f32; 3]>>,
+    /// Light groups, Cryptomatte coverage and deep samples, if kept.
+    pub layers: Option<Layers>,
 }
 
 /// Placement of a rendered window in the full image (an EXR data window
@@ -86,17 +89,18 @@ fn render_with<M: Media>(
 ) -> Rendered {
     let mut counters = Counters::default();
     let lights = lights.clone();
-    let (image, aovs, setup_seconds) = match settings.integrator {
+    let (image, aovs, layers, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
-            let s = PathTracer::new(medium, lights, settings.transmittance, settings.max_depth);
-            let (image, aovs) = run(&s, camera, settings, start, &mut counters);
-            (image, aovs, 0.0)
+            let s = PathTracer::new(medium, lights, settings.transmittance, settings.max_depth)
+                .with_light_groups(!settings.compositing.light_groups.is_empty());
+            let (image, aovs, layers) = run(&s, camera, settings, start, &mut counters);
+            (image, aovs, layers, 0.0)
         }
         IntegratorKind::RayMarch => {
             let s = RayMarcher::new(medium, lights, settings.step_voxels)
                 .with_shadow_step(settings.shadow_step());
-            let (image, aovs) = run(&s, camera, settings, start, &mut counters);
-            (image, aovs, 0.0)
+            let (image, aovs, layers) = run(&s, camera, settings, start, &mut counters);
+            (image, aovs, layers, 0.0)
         }
         IntegratorKind::RayMarch2Pass => {
             let grid = LightGrid::build(
@@ -109,8 +113,8 @@ fn render_with<M: Media>(
             );
             let setup = start.elapsed().as_secs_f64();
             let s = TwoPassMarcher::new(medium, lights, &grid, settings.step_voxels);
-            let (image, aovs) = run(&s, camera, settings, start, &mut counters);
-            (image, aovs, setup)
+            let (image, aovs, layers) = run(&s, camera, settings, start, &mut counters);
+            (image, aovs, layers, setup)
         }
     };
     let wall_seconds = start.elapsed().as_secs_f64();
@@ -139,6 +143,7 @@ fn render_with<M: Media>(
         },
         aovs,
         noisy: None,
+        layers,
     }
 }
 
@@ -172,15 +177,13 @@ fn run<S: CameraSampler>(
     settings: &RenderSettings,
     start: Instant,
     counters: &mut Counters,
-) -> (Image, Option<AovImage>) {
+) -> (Image, Option<AovImage>, Option<Layers>) {
     let crop = crop_of(settings, camera);
     let mut film = Film::new(
-        crop.x0,
-        crop.y0,
-        crop.x1 - crop.x0,
-        crop.y1 - crop.y0,
+        (crop.x0, crop.y0, crop.x1 - crop.x0, crop.y1 - crop.y0),
         settings.tile_size,
         settings.aovs,
+        &settings.compositing,
     );
     let progress = Progress::new(settings, film.width, film.height);
     let passes = Passes {
@@ -190,6 +193,7 @@ fn run<S: CameraSampler>(
         kind: settings.sampler,
         seed: settings.seed,
         progress: &progress,
+        holdout: settings.compositing.holdout_depth.as_deref(),
     };
     let spp = match (settings.budget, settings.adaptive) {
         (Budget::Spp(n), None) => {
@@ -264,7 +268,8 @@ fn run<S: CameraSampler>(
     };
     progress.finish();
     let image = film.resolve(spp, counters);
-    (image, film.resolve_aovs())
+    let layers = film.resolve_layers();
+    (image, film.resolve_aovs(), layers)
 }
 
 /// The most samples any pixel of `film` has.
@@ -302,6 +307,7 @@ struct Passes<'a, S> {
     kind: SamplerKind,
     seed: u64,
     progress: &'a Progress,
+    holdout: Option<&'a DepthHoldout>,
 }
 
 impl<S: CameraSampler> Passes<'_, S> {
@@ -361,8 +367,12 @@ impl<S: CameraSampler> Passes<'_, S> {
             let (u, v) = draws.get_2d(Draw::PixelJitter, 0);
             let time = self.shutter.sample(&draws);
             let ray = self.camera.ray_at(x as f32 + u, y as f32 + v, time);
+            let ray = match self.holdout {
+                Some(h) => ray.with_t_max(h.t_max(x, y, ray.dir, self.camera.forward())),
+                None => ray,
+            };
             let sample = self.sampler.sample_stream(ray, &mut draws, c);
-            tile.add(tx, ty, sample, c);
+            tile.add(tx, ty, sample, ray.dir.dot(self.camera.forward()), c);
             if rule.is_some_and(|r| r.is_checkpoint(s + 1) && r.converged(&tile.pixels[i])) {
                 tile.stopped[i] = true;
                 return u64::from(s + 1 - s0);

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::adaptive::Adaptive;
 use crate::camera::Camera;
+use crate::compositing::Compositing;
 use crate::control::RenderControl;
 use crate::error::{Error, Result};
 use crate::integrator::{IntegratorKind, LightGridSettings};
@@ -105,6 +106,9 @@ pub struct RenderSettings {
     /// moving media must have been built for the same shutter, so their
     /// majorants bound every time drawn.
     pub shutter: Shutter,
+    /// Light groups, holdout depth, Cryptomatte and deep samples
+    /// ([`crate::compositing`]); the default keeps none.
+    pub compositing: Compositing,
 }
 
 /// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
@@ -149,6 +153,7 @@ impl Default for RenderSettings {
             aovs: false,
             control: None,
             shutter: Shutter::INSTANT,
+            compositing: Compositing::default(),
         }
     }
 }
@@ -197,6 +202,7 @@ impl RenderSettings {
         if let Some(a) = &self.adaptive {
             a.validate()?;
         }
+        self.compositing.validate()?;
         Ok(())
     }
 }

@@ -46,6 +46,15 @@ pub fn denoise(r: &mut Rendered) -> Result<()> {
         p[..3].copy_from_slice(c);
     }
     r.noisy = Some(noisy);
+    // Light groups: each denoised with the same guide, then made to sum
+    // to the denoised beauty (crate::compositing::denoise_groups).
+    crate::compositing::denoise_groups(r, |group| {
+        let color: Vec<f32> = group.iter().flatten().copied().collect();
+        let clean = denoiser
+            .denoise(&color, albedo.as_deref(), None, w, h, true)
+            .map_err(|e| Error::input(format!("denoise: {e}")))?;
+        Ok(clean.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    })?;
     r.stats.denoise_seconds = start.elapsed().as_secs_f64();
     Ok(())
 }

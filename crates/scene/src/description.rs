@@ -45,6 +45,21 @@ declare_settings! {
     /// a data window (merge tiles with `cirrus merge`).
     crop: [u32; 4], flag(long, value_parser = parse::crop),
         unset("the whole image"), example([0, 0, 4, 4]);
+    /// Light-group layers (`sun`, `sky`, `emission`) beside the beauty,
+    /// summing to it (also `--aov lights`).
+    light_groups: bool, flag(long, num_args = 0, default_missing_value = "true"),
+        default(false), example(true);
+    /// Cryptomatte ID mattes: `CryptoObject` (per volume's name) and
+    /// `CryptoAsset` (per volume file) layers (also `--aov cryptomatte`).
+    cryptomatte: bool, flag(long, num_args = 0, default_missing_value = "true"),
+        default(false), example(true);
+    /// A deep scanline EXR (Z, ZBack, R, G, B, A) of the camera rays'
+    /// volumetric samples (path tracer).
+    deep: PathBuf, flag(long), unset("none"), example(PathBuf::from("deep.exr"));
+    /// Deep samples per pixel at most, merged by optical depth (plus one
+    /// for the background).
+    deep_samples: u32, flag(long), default(cirrus_render::compositing::DEFAULT_DEEP_SAMPLES),
+        example(4);
     }
 
     /// `[render]`: how to render.
@@ -99,6 +114,16 @@ declare_settings! {
     /// Frames A-B[:STEP]: the frame number replaces `####` or `%04d` in
     /// every input and output path.
     frames: String, flag(long), unset("one frame, no pattern"), example("1-2".into());
+    /// A camera-space depth image (planar depth, as Blender's Z pass) of
+    /// the same camera and size, FILE.exr[:CHANNEL] (in a scene file
+    /// relative to the file): camera rays end there, so the cloud renders
+    /// behind geometry it was never given.
+    holdout_depth: String, flag(long), unset("none; channel: Z, or the one ending in .Z"),
+        example("depth.exr".into());
+    /// Holdout depths at or beyond this are no depth (Blender's
+    /// background).
+    holdout_far: f32, flag(long), default(cirrus_render::compositing::DEFAULT_FAR),
+        example(5.0);
     @file_only {
         /// The frame a single render shows: where time-sampled values
         /// (`transform.samples`, `[camera] samples`, `file_samples`) are
@@ -227,6 +252,12 @@ declare_settings! {
     @file_only {
         /// A .vdb, .nvdb or .cbrk file, relative to the scene file.
         file: PathBuf;
+        /// The volume's name in the Cryptomatte manifest (default: the
+        /// file's stem, made unique with `_2`, `_3`, ...).
+        name: Option<String>;
+        /// A matte: lights and shadows the other volumes, never seen by the
+        /// camera (alpha cut where it stands in front).
+        holdout: Option<bool>;
         /// Temperature grid name: blackbody emission.
         temperature: Option<String>;
         /// Blackbody parameters, `{ scale, offset, temperature_scale }`:
@@ -382,6 +413,11 @@ impl SceneDescription {
         if let Some(map) = self.environment.as_mut().and_then(|e| e.env_map.as_mut()) {
             *map = dir.join(&*map);
         }
+        if let Some(spec) = self.render.holdout_depth.as_mut() {
+            let (file, channel) = crate::compositing::split_depth_spec(spec);
+            let file = dir.join(file).display().to_string();
+            *spec = channel.map_or(file.clone(), |c| format!("{file}:{c}"));
+        }
     }
 
     /// Every input and output path with its frame pattern replaced by `frame`.
@@ -399,11 +435,16 @@ impl SceneDescription {
             *map = substitute(map, frame);
         }
         let o = &mut self.output;
-        for path in [&mut o.output, &mut o.png, &mut o.stats]
+        for path in [&mut o.output, &mut o.png, &mut o.stats, &mut o.deep]
             .into_iter()
             .flatten()
         {
             *path = substitute(path, frame);
+        }
+        if let Some(spec) = self.render.holdout_depth.as_mut() {
+            *spec = substitute(Path::new(spec.as_str()), frame)
+                .display()
+                .to_string();
         }
     }
 

@@ -34,6 +34,7 @@
 //! # Ok::<(), cirrus_scene::Error>(())
 //! ```
 
+pub mod compositing;
 pub mod cull;
 mod declare;
 mod denoise;

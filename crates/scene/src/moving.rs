@@ -171,6 +171,7 @@ pub fn wrap<'v>(
         extinction_tint: inst.extinction_tint,
         albedo: inst.albedo,
         phase: inst.phase,
+        holdout: inst.holdout,
         emission: inst.emission.map(|e| Emission {
             temperature: e.temperature.map(|(f, bb)| (field(f), bb)),
             grid: e.grid.map(|(f, c)| (field(f), c)),

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use cirrus_render::exr_layers::{write_exr_layers, Aov};
+use cirrus_render::exr_layers::{write_exr_with, Aov};
 use cirrus_render::image_io::write_png;
 use cirrus_render::{Crop, Rendered};
 
@@ -22,12 +22,27 @@ pub struct Outputs {
     pub stats: Option<PathBuf>,
     pub aovs: Vec<Aov>,
     pub crop: Option<Crop>,
+    pub light_groups: bool,
+    pub cryptomatte: bool,
+    pub deep: Option<PathBuf>,
+    pub deep_samples: u32,
+    /// Each volume's Cryptomatte name and asset, by its index in the scene.
+    pub object_names: Vec<String>,
+    pub asset_names: Vec<String>,
 }
 
 impl Outputs {
     pub fn resolve(desc: &SceneDescription) -> Outputs {
         let o = &desc.output;
+        let aovs = o.aov.clone().unwrap_or_default();
         Outputs {
+            light_groups: o.light_groups() || aovs.contains(&Aov::Lights),
+            cryptomatte: o.cryptomatte() || aovs.contains(&Aov::Cryptomatte),
+            deep: o.deep.clone(),
+            deep_samples: o.deep_samples(),
+            // A clash of names is refused before rendering (Scene::render).
+            object_names: crate::compositing::instance_names(desc).unwrap_or_default(),
+            asset_names: crate::compositing::asset_names(desc),
             exr: o.output.clone(),
             png: o.png.clone(),
             exposure: o.exposure(),
@@ -40,8 +55,15 @@ impl Outputs {
     /// Writes every output that is set.
     pub fn write(&self, rendered: &Rendered) -> Result<()> {
         let file_err = |p: &Path, e: std::io::Error| Error::file(format!("{}: {e}", p.display()));
+        // The deep file first: an existing EXR marks a finished frame.
+        if let Some(deep) = &self.deep {
+            crate::compositing::write_deep(deep, rendered)?;
+        }
         if let Some(exr) = &self.exr {
-            write_exr_layers(exr, rendered, &self.aovs).map_err(|e| file_err(exr, e))?;
+            let aovs = crate::compositing::written_aovs(self, rendered.layers.as_ref());
+            let (extra, attributes) = crate::compositing::layer_channels(rendered, self);
+            write_exr_with(exr, rendered, &aovs, extra, attributes)
+                .map_err(|e| file_err(exr, e))?;
         }
         if let Some(png) = &self.png {
             write_png(png, &rendered.image, self.exposure).map_err(|e| file_err(png, e))?;

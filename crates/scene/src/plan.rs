@@ -45,6 +45,8 @@ pub struct Plan {
     phase: Phase,
     blackbody: Blackbody,
     emission_colour: Vec3,
+    /// A matte (compositing).
+    holdout: bool,
 }
 
 impl Plan {
@@ -179,6 +181,7 @@ pub fn plan(
         },
         emission_colour: Vec3::from_array(v.emission_color.unwrap_or([1.0; 3]))
             * v.emission_scale.unwrap_or(1.0),
+        holdout: v.holdout.unwrap_or(false),
     })
 }
 
@@ -366,6 +369,7 @@ impl VolumeCache {
         let mut inst = Medium::new(density, extinction.scale, p.albedo, 0.0)
             .with_phase(p.phase.clone())
             .with_extinction_tint(extinction.tint);
+        inst.holdout = p.holdout;
         if p.emits() {
             inst.emission = Some(Emission {
                 temperature: p

@@ -51,6 +51,8 @@ pub struct Prepared<'c> {
     pub centre: DVec3,
     /// Volumes neither the camera nor any light path can reach (not loaded).
     pub culled: u64,
+    /// The scene's index of each instance rendered.
+    pub kept: Vec<usize>,
     pub bytes_read: u64,
     pub grids_loaded: u64,
     /// Wall time spent planning, reading and converting.
@@ -61,6 +63,7 @@ impl Prepared<'_> {
     /// Renders, with the load figures in the statistics.
     pub fn render(&self) -> Rendered {
         let mut rendered = cirrus_render::render(&self.scene, &self.settings);
+        crate::compositing::renumber_instances(&mut rendered, &self.kept);
         let s = &mut rendered.stats;
         s.bytes_read = self.bytes_read;
         s.grids_loaded = self.grids_loaded;
@@ -164,6 +167,7 @@ pub fn prepare<'c>(
         settings: settings.render,
         centre,
         culled: keep.iter().filter(|k| !**k).count() as u64,
+        kept: (0..keep.len()).filter(|&i| keep[i]).collect(),
         bytes_read: cache.bytes_read(),
         grids_loaded: cache.grids_loaded(),
         load_seconds: start.elapsed().as_secs_f64(),

@@ -76,6 +76,7 @@ impl Scene {
             return Err(Error::input("no [[volume]] in the scene"));
         }
         description.rebase(dir);
+        crate::compositing::instance_names(&description)?;
         crate::timeline::hold_file_samples(&mut description);
         Ok(Scene {
             description,
@@ -155,6 +156,12 @@ impl Scene {
         if let Some(c) = &outputs.crop {
             c.validate(settings.res.0, settings.res.1)?;
         }
+        crate::compositing::configure(
+            &mut settings.render,
+            &outputs,
+            &self.description,
+            settings.res,
+        )?;
         prepare(&self.description, settings, self.placement, cache)
     }
 

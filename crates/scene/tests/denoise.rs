@@ -57,3 +57,39 @@ fn denoising_16_spp_cuts_the_error_at_least_5x() {
         "noisy {noisy_mse:.3e} vs denoised {denoised_mse:.3e}"
     );
 }
+
+/// Denoised light groups still sum to the denoised beauty (each denoised
+/// with the albedo guide, then scaled to it), and each stays near its
+/// noisy self: the denoiser moves light within a pixel, not between lights.
+#[test]
+fn denoised_light_groups_sum_to_the_denoised_beauty() {
+    let mut scene = cloud();
+    scene.apply(&Overrides {
+        res: Some((64, 64)),
+        spp: Some(8),
+        denoise: Some(true),
+        light_groups: Some(true),
+        ..Default::default()
+    });
+    let r = match scene.render() {
+        Ok(r) => r,
+        Err(e) if e.kind() == ErrorKind::File && std::env::var_os("CIRRUS_OIDN").is_none() => {
+            eprintln!("SKIPPED: no Open Image Denoise library ({e}); set CIRRUS_OIDN to run");
+            return;
+        }
+        Err(e) => panic!("{e}"),
+    };
+    let layers = r.layers.as_ref().unwrap();
+    let mut worst = 0.0f32;
+    for (i, px) in r.image.rgba.iter().enumerate() {
+        for c in 0..3 {
+            let sum: f32 = layers.groups.iter().map(|g| g[i][c]).sum();
+            worst = worst.max((sum - px[c]).abs() / px[c].abs().max(1e-3));
+        }
+    }
+    eprintln!("denoised groups against the denoised beauty: largest relative gap {worst:e}");
+    assert!(worst <= 1e-5, "{worst}");
+    let noisy = r.noisy.as_ref().unwrap();
+    let differs = r.image.rgba.iter().zip(noisy).any(|(d, n)| d[0] != n[0]);
+    assert!(differs, "the beauty was denoised");
+}

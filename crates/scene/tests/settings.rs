@@ -68,12 +68,33 @@ fn context(keyword: &str) -> Overrides {
             o.shutter = Some([-0.25, 0.25]);
             o.velocity = Some("velocity".into());
         }
+        "deep_samples" => o.deep = Some(PathBuf::from("deep.exr")),
+        "holdout_far" => o.holdout_depth = Some(depth_image().display().to_string()),
         "env_rotation" | "env_intensity" => {
             o.env_map = Some(repo().join("data/sky.exr"));
         }
         _ => {}
     }
     o
+}
+
+/// A 6x4 depth image (planar depths from 1 to 24, as another renderer's
+/// Z pass), written once.
+fn depth_image() -> PathBuf {
+    use exr::prelude::*;
+    let path = std::env::temp_dir().join(format!("cirrus-settings-{}.exr", std::process::id()));
+    if !path.exists() {
+        let depths: Vec<f32> = (1..=24).map(|d| d as f32).collect();
+        let channel = AnyChannel::new("Z", FlatSamples::F32(depths));
+        let layer = Layer::new(
+            (6, 4),
+            LayerAttributes::default(),
+            Encoding::FAST_LOSSLESS,
+            AnyChannels::sort(smallvec::smallvec![channel]),
+        );
+        Image::from_layer(layer).write().to_file(&path).unwrap();
+    }
+    path
 }
 
 /// Everything the renderer is handed for `scene`, and the outputs: the
@@ -164,6 +185,13 @@ fn every_setting_reaches_the_renderer() {
         before.apply(&context(keyword));
         let mut after = before.clone();
         after.apply(&example);
+        if keyword == "holdout_depth" {
+            // The declared example names no file here: the one written.
+            after.apply(&Overrides {
+                holdout_depth: Some(depth_image().display().to_string()),
+                ..Default::default()
+            });
+        }
         let (a, b) = (handed(&before), handed(&after));
         assert!(!a.starts_with("error"), "{keyword}: the context fails: {a}");
         assert!(!b.starts_with("error"), "{keyword}: the example fails: {b}");

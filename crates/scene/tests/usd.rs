@@ -308,7 +308,11 @@ fn mutated_stages_fail_cleanly_or_render() {
                 }
             }
             Err(e) => {
-                assert!(e.to_string().contains(&format!("m{k}.{ext}")), "{}", e.to_string());
+                assert!(
+                    e.to_string().contains(&format!("m{k}.{ext}")),
+                    "{}",
+                    e.to_string()
+                );
                 refused += 1;
             }
         }

@@ -155,3 +155,21 @@ def test_broken_and_missing_inputs_fail_only_their_frames(tmp_path, cirrus_bin, 
         reference = render_reference(
             cirrus_bin, str(tmp_path / f"cloud.{frame:04d}.vdb"), tmp_path / f"ref{frame}.exr")
         assert_same_pixels(tmp_path / f"out.{frame:04d}.exr", reference)
+
+
+def test_deep_images_of_tiled_frames_match_single_machine_renders(tmp_path, cirrus_bin, client):
+    """`--deep PATTERN`: each tile writes its own deep tile, the merge
+    assembles the frame's deep image, bit for bit the untiled render's."""
+    pattern = make_frame_inputs(tmp_path, {1: "cloud.vdb"})
+    flags = [*RENDER_FLAGS, "--deep", str(tmp_path / "deep.####.exr")]
+    result = render_job(
+        pattern, str(tmp_path / "out.####.exr"), "1-1", tiles=(2, 2),
+        render_flags=flags, cirrus=cirrus_bin, client=client, threads_per_task=1,
+    )
+    assert result.ok, result.frames
+    reference = tmp_path / "ref.deep.exr"
+    render_reference(cirrus_bin, str(tmp_path / "cloud.0001.vdb"), tmp_path / "ref.exr",
+                     flags=[*RENDER_FLAGS, "--deep", str(reference)])
+    merged = (tmp_path / "deep.0001.exr").read_bytes()
+    assert len(merged) > 1000 and merged == reference.read_bytes()
+    assert hidden_files(tmp_path) == []

@@ -1,4 +1,5 @@
-//! `cirrus merge OUT.exr TILE.exr...`: crop tiles into one image.
+//! `cirrus merge OUT.exr TILE.exr...`: crop tiles into one image (flat
+//! tiles, or deep tiles written by `--deep`).
 
 use super::CliResult;
 use std::path::PathBuf;
@@ -17,7 +18,11 @@ pub struct MergeArgs {
 /// bit the full render when the tiles were rendered with its seed.
 pub fn run(args: &MergeArgs) -> CliResult {
     let tiles: Vec<&std::path::Path> = args.tiles.iter().map(|p| p.as_path()).collect();
-    cirrus_render::exr_layers::merge_tiles(&args.output, &tiles)?;
+    if cirrus_deep_exr::is_deep_file(tiles[0])? {
+        cirrus_deep_exr::merge(&args.output, &tiles)?;
+    } else {
+        cirrus_render::exr_layers::merge_tiles(&args.output, &tiles)?;
+    }
     eprintln!(
         "{}: merged {} tiles",
         args.output.display(),

@@ -84,7 +84,7 @@ def _flag_value(key: str, value: Any) -> Any:
     """Keyword values in the forms the command line accepts."""
     if key == "res" and isinstance(value, (tuple, list)):
         return f"{int(value[0])}x{int(value[1])}"
-    if key in ("output", "png", "stats", "env_map") and value is not None:
+    if key in ("output", "png", "stats", "env_map", "deep", "holdout_depth") and value is not None:
         return os.fspath(value)
     if key == "aov" and isinstance(value, str):
         return [a.strip() for a in value.split(",") if a.strip()]
@@ -105,7 +105,10 @@ def render(
     Returns the image as a float32 array (H, W, 4) and the statistics as a
     dict (``"warnings"``: what the scene's reader could not render, also
     issued as :class:`SceneWarning`); with ``aov=[...]`` the statistics hold ``"aovs"``, one float32
-    (H, W, C) array per layer. ``progress(done, total)`` is called about
+    (H, W, C) array per layer, and with ``light_groups=True`` one (H, W, 3)
+    array per light group (``sun``, ``sky``, ``emission``). Compositing:
+    ``holdout_depth="z.exr[:CHANNEL]"``, ``deep="deep.exr"``,
+    ``cryptomatte=True`` (written into ``output``). ``progress(done, total)`` is called about
     every 50 ms once rendering has begun; if it raises, the render stops and the exception
     propagates, as Ctrl-C does. ``threads`` sets the worker count (the
     image is the same on any count). Outputs named by the overrides

@@ -254,17 +254,23 @@ impl LightGrid {
     /// `dir` (pass two's in-scattering term).
     /// A map environment lights with its mean radiance here: the grid
     /// stores only the sky's transmittance (a biased baseline).
-    pub fn in_scatter(&self, phase: &Phase, lights: &Lights, p: Vec3, dir: Vec3) -> Vec3 {
+    pub(crate) fn in_scatter(
+        &self,
+        phase: &Phase,
+        lights: &Lights,
+        p: Vec3,
+        dir: Vec3,
+    ) -> super::LightParts {
         let e = self.lookup(p);
-        let mut s = Vec3::ZERO;
+        let mut s = super::LightParts::default();
         if let Some(sun) = &lights.sun {
             let f = phase.eval(dir, -sun.direction());
-            s += sun.irradiance() * (f * e[0]);
+            s.sun = sun.irradiance() * (f * e[0]);
         }
         if let Some(env) = &lights.environment {
             let b = Vec3::new(e[2], e[3], e[4]);
             let band = e[1] + 3.0 * phase.mean_cosine() * b.dot(dir);
-            s += env.mean_radiance() * band.max(0.0);
+            s.sky = env.mean_radiance() * band.max(0.0);
         }
         s
     }

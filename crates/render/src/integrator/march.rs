@@ -16,7 +16,8 @@
 
 use glam::Vec3;
 
-use super::{escaped_radiance, Sample};
+use super::{escaped_radiance, LightParts, Sample};
+use crate::compositing::{tag, GroupRadiance, LightGroup};
 use crate::light::Lights;
 use crate::medium::{Lattice, Media};
 use crate::phase::Phase;
@@ -156,36 +157,60 @@ pub(crate) fn march_camera_ray<M: Media, E: Spectrum>(
     h: f32,
     rng: &mut Rng,
     c: &mut Counters,
-    mut in_scatter: impl FnMut(Vec3, &Phase, &mut Rng, &mut Counters) -> Vec3,
+    mut in_scatter: impl FnMut(Vec3, &Phase, &mut Rng, &mut Counters) -> LightParts,
 ) -> Sample {
     c.paths += 1;
     let emits = medium.emits();
     let chromatic = medium.chromatic();
     let mut tr = E::ONE;
     let mut l = Vec3::ZERO;
+    let mut groups = GroupRadiance::default();
+    // Opacity of the holdout volumes' steps: cut from alpha, as a matte.
+    let mut held = 0.0f32;
     let u = rng.uniform();
-    march(medium, ray, f32::INFINITY, h, u, c, |t, sigma: E, c| {
+    march(medium, ray, ray.t_max, h, u, c, |t, sigma: E, c| {
         if !sigma.any_positive() {
             return true;
         }
         let step_tr = sigma.scale(h).exp_neg();
         let p = ray.at(t);
         let it = medium.interaction(p, 0.0, rng);
-        let mut source = it.albedo * in_scatter(p, it.phase, rng, c);
+        let parts = in_scatter(p, it.phase, rng, c);
+        let mut source = it.albedo * parts.total();
+        let mut emitted = Vec3::ZERO;
         if emits {
-            source += (Vec3::ONE - it.albedo) * medium.emission(p, 0.0, it.instance, c);
+            emitted = (Vec3::ONE - it.albedo) * medium.emission(p, 0.0, it.instance, c);
+            source += emitted;
         }
+        let weight = if chromatic { it.weight } else { Vec3::ONE };
         if chromatic {
             source *= it.weight;
         }
-        l += tr.mul(step_tr.one_minus()).tint(source);
+        let step = tr.mul(step_tr.one_minus());
+        if it.holdout {
+            held += step.mean();
+        } else {
+            l += step.tint(source);
+            parts.scaled(step.tint(it.albedo * weight)).tag(&mut groups);
+            tag(
+                &mut groups,
+                LightGroup::Emission,
+                step.tint(emitted * weight),
+            );
+        }
         tr = tr.mul(step_tr);
         tr.roulette(rng)
     });
-    l += tr.tint(escaped_radiance(lights, ray.dir, None, c));
+    // A ray ended by a depth holdout sees nothing behind it.
+    if ray.t_max.is_infinite() {
+        let parts = escaped_radiance(lights, ray.dir, None, c);
+        l += tr.tint(parts.total());
+        parts.scaled(tr.tint(Vec3::ONE)).tag(&mut groups);
+    }
     Sample {
         radiance: l,
-        alpha: 1.0 - tr.mean(),
+        alpha: 1.0 - tr.mean() - held,
+        groups,
         ..Default::default()
     }
 }

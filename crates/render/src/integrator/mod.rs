@@ -21,6 +21,7 @@ pub use raymarch2pass::TwoPassMarcher;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::compositing::GroupRadiance;
 use crate::light::Lights;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Rng, SampleStream};
@@ -68,6 +69,9 @@ pub struct Sample {
     pub radiance: Vec3,
     pub alpha: f32,
     pub aov: AovSample,
+    /// `radiance` split by light group ([`crate::compositing`]): the same
+    /// contributions, each added to its light's group as well.
+    pub groups: GroupRadiance,
 }
 
 /// The AOV parts of one sample (filled by the path tracer; the marchers
@@ -86,6 +90,10 @@ pub struct AovSample {
     /// the MIS-weighted light hit by the phase-sampled ray at the first
     /// scattering event (no background, no emission, no multiple scattering).
     pub direct: Vec3,
+    /// The instance of the camera ray's first real collision, if it was a
+    /// visible one (not a holdout); Cryptomatte's coverage and the deep
+    /// bins count it.
+    pub instance: Option<u32>,
 }
 
 /// Anything that turns a camera ray into a [`Sample`]; `Sync` so tiles can
@@ -113,16 +121,48 @@ pub(crate) fn escaped_radiance(
     dir: Vec3,
     phase_pdf: Option<f32>,
     c: &mut Counters,
-) -> Vec3 {
+) -> LightParts {
     let weight = |light_pdf: f32| phase_pdf.map_or(1.0, |p| power_heuristic(p, light_pdf));
-    let mut l = Vec3::ZERO;
+    let mut l = LightParts::default();
     if let Some(env) = &lights.environment {
         c.env_samples += 1;
         let (radiance, pdf) = env.eval(dir);
-        l += radiance * weight(pdf);
+        l.sky = radiance * weight(pdf);
     }
     if let Some((radiance, pdf)) = lights.sun.as_ref().and_then(|s| s.hit(dir)) {
-        l += radiance * weight(pdf);
+        l.sun = radiance * weight(pdf);
     }
     l
+}
+
+/// Light arriving from each of the lights at infinity, kept apart for the
+/// light groups; [`LightParts::total`] is what the integrators add.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct LightParts {
+    pub sun: Vec3,
+    pub sky: Vec3,
+}
+
+impl LightParts {
+    /// The sum, as the integrators always added it (0 + sky + sun).
+    #[inline]
+    pub fn total(self) -> Vec3 {
+        self.sky + self.sun
+    }
+
+    #[inline]
+    pub fn scaled(self, w: Vec3) -> Self {
+        Self {
+            sun: self.sun * w,
+            sky: self.sky * w,
+        }
+    }
+
+    /// Adds each part to its light's group.
+    #[inline]
+    pub fn tag(self, groups: &mut GroupRadiance) {
+        use crate::compositing::{tag, LightGroup};
+        tag(groups, LightGroup::Sun, self.sun);
+        tag(groups, LightGroup::Sky, self.sky);
+    }
 }

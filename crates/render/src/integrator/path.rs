@@ -2,7 +2,8 @@
 
 use glam::Vec3;
 
-use super::{escaped_radiance, AovSample, CameraSampler, Sample};
+use super::{escaped_radiance, AovSample, CameraSampler, LightParts, Sample};
+use crate::compositing::{tag, GroupRadiance, LightGroup};
 use crate::light::{LightSample, Lights};
 use crate::medium::Media;
 use crate::phase::Phase;
@@ -69,6 +70,9 @@ pub struct PathTracer<'a, M> {
     estimator: TransmittanceEstimator,
     max_depth: Option<u32>,
     chromatic: bool,
+    /// Tag contributions with their light groups (off: `Sample::groups`
+    /// stays zero and costs nothing).
+    light_groups: bool,
 }
 
 impl<'a, M: Media> PathTracer<'a, M> {
@@ -84,6 +88,15 @@ impl<'a, M: Media> PathTracer<'a, M> {
             estimator,
             max_depth,
             chromatic: medium.chromatic(),
+            light_groups: false,
+        }
+    }
+
+    /// Splits each sample's radiance into light groups as well.
+    pub fn with_light_groups(self, light_groups: bool) -> Self {
+        Self {
+            light_groups,
+            ..self
         }
     }
 
@@ -99,14 +112,14 @@ impl<'a, M: Media> PathTracer<'a, M> {
         vertex: u32,
         draws: &mut SampleStream,
         c: &mut Counters,
-    ) -> Vec3 {
-        let mut l = Vec3::ZERO;
+    ) -> LightParts {
+        let mut l = LightParts::default();
         if let Some(sun) = &self.lights.sun {
             let (u1, u2) = draws.get_2d(Draw::SunDirection, vertex);
             let s = sun.sample(u1, u2);
             c.nee_rays_sun += 1;
             let shadow = (Draw::SunShadow, vertex);
-            l += self.light_term::<S>(p, ray_in, phase, s, mis, shadow, draws, c);
+            l.sun = self.light_term::<S>(p, ray_in, phase, s, mis, shadow, draws, c);
         }
         if let Some(env) = &self.lights.environment {
             let (u1, u2) = draws.get_2d(Draw::SkyDirection, vertex);
@@ -115,7 +128,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             // A zero-density sample (a pole) is dropped without a shadow ray.
             c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
             let shadow = (Draw::SkyShadow, vertex);
-            l += self.light_term::<S>(p, ray_in, phase, s, mis, shadow, draws, c);
+            l.sky = self.light_term::<S>(p, ray_in, phase, s, mis, shadow, draws, c);
         }
         l
     }
@@ -188,6 +201,7 @@ impl<M: Media> PathTracer<'_, M> {
         let mut l = Vec3::ZERO;
         let mut alpha = 0.0;
         let mut aov = AovSample::default();
+        let mut groups = GroupRadiance::default();
         let mut depth = 0u32;
         let mut phase_pdf = None;
         // Set after the last allowed scattering event when the media emit:
@@ -199,7 +213,7 @@ impl<M: Media> PathTracer<'_, M> {
             // vertex `vertex` of the draw allocation.
             let vertex = depth;
             let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
-                sample_free_flight::<S, M>(self.medium, &ray, f32::INFINITY, &mut beta, rng, c)
+                sample_free_flight::<S, M>(self.medium, &ray, ray.t_max, &mut beta, rng, c)
             });
             if depth == 0 {
                 alpha = match flight {
@@ -209,8 +223,15 @@ impl<M: Media> PathTracer<'_, M> {
             }
             let t = match flight {
                 FreeFlight::Escaped if emission_only => break,
+                // A camera ray ended by a depth holdout: what lies behind
+                // the held-out geometry, the sky included, never shows.
+                FreeFlight::Escaped if ray.t_max.is_finite() => break,
                 FreeFlight::Escaped => {
-                    let e = beta * escaped_radiance(&self.lights, ray.dir, phase_pdf, c);
+                    let parts = escaped_radiance(&self.lights, ray.dir, phase_pdf, c);
+                    let e = beta * parts.total();
+                    if self.light_groups {
+                        parts.scaled(beta).tag(&mut groups);
+                    }
                     l += e;
                     if depth == 1 {
                         aov.direct += e;
@@ -226,8 +247,14 @@ impl<M: Media> PathTracer<'_, M> {
                 beta *= it.weight;
             }
             if depth == 0 {
+                // A holdout volume seen first is a matte: no light, no alpha.
+                if it.holdout {
+                    alpha = 0.0;
+                    break;
+                }
                 aov.albedo = it.albedo;
                 aov.depth = Some(t);
+                aov.instance = Some(it.instance);
             }
             if emits {
                 let e = beta
@@ -235,6 +262,9 @@ impl<M: Media> PathTracer<'_, M> {
                     * self.medium.emission(p, ray.time, it.instance, c);
                 l += e;
                 aov.emission += e;
+                if self.light_groups {
+                    tag(&mut groups, LightGroup::Emission, e);
+                }
             }
             if self.max_depth == Some(depth) {
                 break;
@@ -245,7 +275,11 @@ impl<M: Media> PathTracer<'_, M> {
                 break;
             }
             let last = self.max_depth == Some(depth);
-            let direct = beta * self.direct_light::<S>(p, &ray, it.phase, !last, vertex, draws, c);
+            let parts = self.direct_light::<S>(p, &ray, it.phase, !last, vertex, draws, c);
+            let direct = beta * parts.total();
+            if self.light_groups {
+                parts.scaled(beta).tag(&mut groups);
+            }
             l += direct;
             if depth == 1 {
                 aov.direct += direct;
@@ -274,6 +308,7 @@ impl<M: Media> PathTracer<'_, M> {
             radiance: l,
             alpha,
             aov,
+            groups,
         }
     }
 }

@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use super::march::{march_camera_ray, marched_transmittance, ShadowEnd};
-use super::{CameraSampler, Sample};
+use super::{CameraSampler, LightParts, Sample};
 use crate::light::Lights;
 use crate::medium::Media;
 use crate::phase::Phase;
@@ -63,8 +63,8 @@ impl<'a, M: Media> RayMarcher<'a, M> {
         phase: &Phase,
         rng: &mut Rng,
         c: &mut Counters,
-    ) -> Vec3 {
-        let mut s = Vec3::ZERO;
+    ) -> LightParts {
+        let mut s = LightParts::default();
         if let Some(sun) = &self.lights.sun {
             // Sampling the disc uniformly: radiance / pdf is the irradiance.
             let ls = sun.sample(rng.uniform(), rng.uniform());
@@ -78,7 +78,7 @@ impl<'a, M: Media> RayMarcher<'a, M> {
                 rng,
                 c,
             );
-            s += tr.scale(f).tint(sun.irradiance());
+            s.sun = tr.scale(f).tint(sun.irradiance());
         }
         if let Some(env) = &self.lights.environment {
             let (w, _) = phase.sample(dir, rng.uniform(), rng.uniform());
@@ -92,7 +92,7 @@ impl<'a, M: Media> RayMarcher<'a, M> {
                 c,
             );
             c.env_samples += 1;
-            s += tr.tint(env.eval(w).0);
+            s.sky = tr.tint(env.eval(w).0);
         }
         s
     }

@@ -40,6 +40,9 @@ pub struct Interaction<'a> {
     /// chosen with. 1 for grey media, where `q_i` is that share exactly;
     /// chromatic estimators multiply by it.
     pub weight: Vec3,
+    /// The instance is a holdout: it shadows and lights the others as
+    /// before, but a camera path that meets it first shows nothing.
+    pub holdout: bool,
 }
 
 /// The participating media of a scene, in render space: what the trackers

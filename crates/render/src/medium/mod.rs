@@ -68,6 +68,8 @@ pub struct Medium<F> {
     pub albedo: Vec3,
     pub phase: Phase,
     pub emission: Option<Emission<F>>,
+    /// A matte: lights and shadows the others, never seen by the camera.
+    pub holdout: bool,
 }
 
 impl<F: DensityField> Medium<F> {
@@ -81,6 +83,7 @@ impl<F: DensityField> Medium<F> {
             albedo,
             phase: Phase::hg(g),
             emission: None,
+            holdout: false,
         }
     }
 

@@ -35,6 +35,7 @@ impl<F: DensityField> Medium<F> {
             phase: &self.phase,
             instance: instance as u32,
             weight,
+            holdout: self.holdout,
         }
     }
 }

@@ -12,11 +12,16 @@ use glam::Vec3;
 /// lumpy modulation, zero near the array's faces, so the field has empty
 /// cells, interior cells and structure for the majorant grid to bound.
 pub fn cloud_field(cell_voxels: usize) -> GridField {
+    cloud_field_at(cell_voxels, Vec3::ZERO)
+}
+
+/// [`cloud_field`] moved by `offset`.
+pub fn cloud_field_at(cell_voxels: usize, offset: Vec3) -> GridField {
     let n = 16;
     let vs = 1.0 / n as f32;
     GridField::from_fn(
         [n, n, n],
-        Vec3::splat(0.5 * vs),
+        Vec3::splat(0.5 * vs) + offset,
         vs,
         cell_voxels,
         |i, j, k| {

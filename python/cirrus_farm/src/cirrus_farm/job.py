@@ -22,7 +22,7 @@ import distributed
 from . import worker_tasks
 from .cluster import local_client
 from .frames import FrameSpecError, parse_frame_range
-from .plan import FramePlan, PlanError, plan_job
+from .plan import FramePlan, PlanError, plan_job, without_flag
 from .shipping import ShippedByValue
 
 RENDER_TILE = ShippedByValue(worker_tasks.render_tile, worker_tasks)
@@ -183,14 +183,19 @@ def _submit(
     finished frames (and their merges) appear in order, not all at the end."""
     job_id = uuid.uuid4().hex[:8]
     cwd = os.getcwd()
-    flags = list(render_flags)
+    # Each task gets its own deep file (`--deep` names the frames').
+    flags = without_flag(render_flags, "--deep")
+
+    def task_flags(deep: str | None) -> list[str]:
+        return flags + ["--deep", deep] if deep else flags
+
     submitted: dict[distributed.Future, _Submitted] = {}
     for order, plan in enumerate(plans):
         priority = -order
         frame_key = f"cirrus-{job_id}-frame{plan.frame}"
         if plan.renders_straight_to_output:
             future = client.submit(
-                RENDER_TILE, cirrus, plan.input, plan.output, flags,
+                RENDER_TILE, cirrus, plan.input, plan.output, task_flags(plan.deep),
                 None, False, threads, cwd,
                 key=f"{frame_key}-render", retries=retries, priority=priority,
             )
@@ -201,7 +206,7 @@ def _submit(
             tile = task.tile
             assert tile is not None
             future = client.submit(
-                RENDER_TILE, cirrus, plan.input, task.path, flags,
+                RENDER_TILE, cirrus, plan.input, task.path, task_flags(task.deep),
                 tile.crop_flag, not overwrite, threads, cwd,
                 key=f"{frame_key}-tile-{tile.column}-{tile.row}",
                 retries=retries, priority=priority,
@@ -211,6 +216,7 @@ def _submit(
         merge = client.submit(
             MERGE_TILES, cirrus, plan.output,
             [t.path for t in plan.tiles], tile_futures, threads, cwd,
+            plan.deep, [t.deep for t in plan.tiles if t.deep],
             key=f"{frame_key}-merge", retries=retries, priority=priority + 1,
         )
         submitted[merge] = _Submitted(plan, "merge", None)

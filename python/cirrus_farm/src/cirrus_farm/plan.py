@@ -35,10 +35,12 @@ class PlanError(ValueError):
 
 @dataclass(frozen=True)
 class TileTask:
-    """One `cirrus render` run: the whole frame (`tile` None) or a crop."""
+    """One `cirrus render` run: the whole frame (`tile` None) or a crop,
+    with its deep image when the job writes deep images."""
 
     tile: Tile | None
     path: str
+    deep: str | None = None
 
 
 @dataclass(frozen=True)
@@ -49,6 +51,7 @@ class FramePlan:
     input: str
     output: str
     tiles: tuple[TileTask, ...]
+    deep: str | None = None
 
     @property
     def renders_straight_to_output(self) -> bool:
@@ -65,6 +68,19 @@ def flag_value(flags: Sequence[str], name: str) -> str | None:
         elif flag.startswith(name + "="):
             value = flag[len(name) + 1 :]
     return value
+
+
+def without_flag(flags: Sequence[str], name: str) -> list[str]:
+    """`flags` less every `name VALUE` and `name=VALUE`."""
+    out, skip = [], False
+    for i, flag in enumerate(flags):
+        if skip:
+            skip = False
+        elif flag == name and i + 1 < len(flags):
+            skip = True
+        elif not flag.startswith(name + "="):
+            out.append(flag)
+    return out
 
 
 def check_render_flags(flags: Sequence[str]) -> None:
@@ -108,6 +124,11 @@ def tile_file_path(output: str, tile: Tile) -> str:
     return os.path.join(folder, f".{stem}.tile-{tile.column}-{tile.row}.exr")
 
 
+def deep_tile_path(deep: str, tile: Tile) -> str:
+    """The hidden deep tile beside a frame's deep image (`--deep`)."""
+    return tile_file_path(deep, tile)
+
+
 def plan_job(
     input_pattern: str,
     output_pattern: str,
@@ -130,17 +151,22 @@ def plan_job(
             tiles = split_image(width, height, columns, rows)
         except TileSpecError as e:
             raise PlanError(str(e)) from None
+    deep_pattern = flag_value(render_flags, "--deep")
     try:
         inputs = {f: expand_frame_pattern(os.path.abspath(input_pattern), f) for f in frames}
         outputs = expand_distinct(os.path.abspath(output_pattern), frames)
+        deeps = (expand_distinct(os.path.abspath(deep_pattern), frames)
+                 if deep_pattern is not None else {})
     except FrameSpecError as e:
         raise PlanError(str(e)) from None
     plans = []
     for frame in frames:
-        output = outputs[frame]
+        output, deep = outputs[frame], deeps.get(frame)
         if tiles is None:
-            tasks = (TileTask(None, output),)
+            tasks = (TileTask(None, output, deep),)
         else:
-            tasks = tuple(TileTask(t, tile_file_path(output, t)) for t in tiles)
-        plans.append(FramePlan(frame, inputs[frame], output, tasks))
+            tasks = tuple(
+                TileTask(t, tile_file_path(output, t), deep and deep_tile_path(deep, t))
+                for t in tiles)
+        plans.append(FramePlan(frame, inputs[frame], output, tasks, deep))
     return plans

@@ -108,6 +108,8 @@ def merge_tiles(
     tile_outcomes: Sequence[dict],
     threads: int | None = None,
     cwd: str | None = None,
+    deep_output: str | None = None,
+    deep_tiles: Sequence[str] = (),
 ) -> dict:
     """Merges a frame's tiles into `output_path`, then deletes the tiles.
 
@@ -118,7 +120,8 @@ def merge_tiles(
 
     The merge writes to a temporary name in the output's folder and
     renames it, so the output exists only once it is complete, even if
-    this worker dies mid-write.
+    this worker dies mid-write. Deep tiles (`--deep`) merge into
+    `deep_output` first, so a finished output means a finished deep image.
     """
     host = socket.gethostname()
     for outcome in tile_outcomes:
@@ -128,15 +131,18 @@ def merge_tiles(
         # An earlier attempt renamed the output into place and began deleting
         # the tiles before its worker died: the frame is done.
         return {"status": "merged", "seconds": 0.0, "host": host}
-    folder, name = os.path.split(output_path)
-    partial = os.path.join(folder, f".{name}.merging-{os.getpid()}.exr")
-    outcome = _run_cirrus([cirrus, "merge", partial, *tile_paths], threads, cwd)
-    outcome["host"] = host
-    if outcome["status"] != "ok":
-        _remove_quietly(partial)
-        return outcome
-    os.replace(partial, output_path)
-    for path in tile_paths:
+    merges = [(deep_output, list(deep_tiles))] if deep_output else []
+    merges.append((output_path, list(tile_paths)))
+    for target, parts in merges:
+        folder, name = os.path.split(target)
+        partial = os.path.join(folder, f".{name}.merging-{os.getpid()}.exr")
+        outcome = _run_cirrus([cirrus, "merge", partial, *parts], threads, cwd)
+        outcome["host"] = host
+        if outcome["status"] != "ok":
+            _remove_quietly(partial)
+            return outcome
+        os.replace(partial, target)
+    for path in [*tile_paths, *deep_tiles]:
         _remove_quietly(path)
     outcome["status"] = "merged"
     return outcome

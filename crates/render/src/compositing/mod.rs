@@ -1,0 +1,112 @@
+//! What compositors need beyond the beauty: light groups, holdouts, deep
+//! samples and ID mattes (Cryptomatte), as production renderers write them.
+//!
+//! - Light groups: every contribution an integrator adds is tagged with the
+//!   group of the light it came from ([`LightGroup`]); a [`Sample`]
+//!   carries the per-group radiance beside the total, and the film keeps
+//!   one mean per group. The groups are the same estimate split, so they
+//!   sum to the beauty to float rounding.
+//! - Holdouts: [`DepthHoldout`] ends each camera ray at a depth image's
+//!   depth (`Ray::t_max`); a holdout volume ([`Media::holdout`]) ends a
+//!   camera path that first collides in it with no light and no alpha.
+//! - `film`: the per-tile accumulators of the layers ([`TileLayers`]) and
+//!   the resolved [`Layers`].
+//! - `deep`: per-pixel bins of the camera ray's first collision depth,
+//!   resolved into deep samples whose "over" composite is the flat mean.
+//! - `cryptomatte`: the IDs, ranks and manifest of the Cryptomatte
+//!   specification.
+//!
+//! [`Sample`]: crate::Sample
+//! [`Media::holdout`]: crate::Media::holdout
+
+pub mod cryptomatte;
+pub mod deep;
+mod depth_image;
+pub(crate) mod film;
+
+pub use deep::DeepSample;
+pub use depth_image::{DepthHoldout, DEFAULT_FAR};
+pub use film::Layers;
+pub(crate) use film::TileLayers;
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+/// The most light groups a render keeps (each costs 24 bytes a pixel of
+/// film and 12 a sample).
+pub const MAX_LIGHT_GROUPS: usize = 8;
+
+/// Radiance per light group, indexed by the group's position in
+/// [`Compositing::light_groups`].
+pub type GroupRadiance = [Vec3; MAX_LIGHT_GROUPS];
+
+/// The group each of the renderer's lights is tagged with: the index of
+/// its layer in [`DEFAULT_LIGHT_GROUPS`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightGroup {
+    Sun = 0,
+    Sky = 1,
+    Emission = 2,
+}
+
+/// Layer names of the groups today's lights are tagged with, in tag order.
+pub const DEFAULT_LIGHT_GROUPS: [&str; 3] = ["sun", "sky", "emission"];
+
+/// Adds `value` to group `g` of `groups`.
+#[inline]
+pub(crate) fn tag(groups: &mut GroupRadiance, g: LightGroup, value: Vec3) {
+    groups[g as usize] += value;
+}
+
+/// Deep samples per pixel when none is given (the background sample
+/// comes on top).
+pub const DEFAULT_DEEP_SAMPLES: u32 = 16;
+
+/// The compositing outputs a render keeps; the default keeps none.
+#[derive(Clone, Debug, Default)]
+pub struct Compositing {
+    /// Names of the light-group layers, by group index; empty: none kept.
+    pub light_groups: Vec<String>,
+    /// Keep per-instance coverage of the camera rays' first collisions.
+    pub cryptomatte: bool,
+    /// Keep deep samples, at most this many per pixel (plus background).
+    pub deep_samples: Option<u32>,
+    /// End camera rays at these depths.
+    pub holdout_depth: Option<Arc<DepthHoldout>>,
+}
+
+impl Compositing {
+    /// Whether the film keeps anything beyond the beauty and AOVs.
+    pub fn keeps_layers(&self) -> bool {
+        !self.light_groups.is_empty() || self.cryptomatte || self.deep_samples.is_some()
+    }
+
+    /// Checks the group names: at most [`MAX_LIGHT_GROUPS`], each a
+    /// non-empty layer name (no `.`), no two alike.
+    pub fn validate(&self) -> crate::error::Result<()> {
+        use crate::error::Error;
+        if self.light_groups.len() > MAX_LIGHT_GROUPS {
+            return Err(Error::invalid(format!(
+                "{} light groups; at most {MAX_LIGHT_GROUPS} are kept",
+                self.light_groups.len()
+            )));
+        }
+        for (i, name) in self.light_groups.iter().enumerate() {
+            if name.is_empty() || name.contains('.') || name.chars().any(char::is_whitespace) {
+                return Err(Error::invalid(format!(
+                    "light group {name:?}: a layer name must be non-empty, without '.' or spaces"
+                )));
+            }
+            if self.light_groups[..i].contains(name) {
+                return Err(Error::invalid(format!(
+                    "light group {name:?} is named twice"
+                )));
+            }
+        }
+        if self.deep_samples == Some(0) {
+            return Err(Error::invalid("deep samples per pixel must be at least 1"));
+        }
+        Ok(())
+    }
+}
