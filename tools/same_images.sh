@@ -8,7 +8,9 @@
 # Covers every integrator and estimator, chromatic media, phases, the sky
 # map, motion blur, emission, the example scene, AOVs, the global and
 # automatic majorants, .nvdb and .cbrk input, and crops with their merge.
-# Prints one line per image and exits non-zero if any differ.
+# Prints one line per image and exits non-zero if any differ. NEW_FLAGS,
+# if set, is added to every render of the new build (say, to turn off a
+# default the old build did not have: NEW_FLAGS="--guiding off").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 old=$(readlink -f "$1")
@@ -57,19 +59,22 @@ suite=(
 failed=0
 for build in old new; do
   bin=$old
-  [ "$build" = new ] && bin=$new
+  extra=""
+  [ "$build" = new ] && bin=$new && extra=${NEW_FLAGS:-}
   d="$out/$build"
   for entry in "${suite[@]}"; do
     name=${entry%%|*}
     args=${entry#*|}
     # shellcheck disable=SC2086
-    "$bin" render $args -o "$d/$name.exr" >/dev/null 2>"$d/$name.log" ||
+    "$bin" render $args $extra -o "$d/$name.exr" >/dev/null 2>"$d/$name.log" ||
       { echo "$build $name: render failed (see $d/$name.log)"; failed=1; }
   done
   "$bin" convert data/cloud.vdb -o "$d/cloud.cbrk" >/dev/null 2>&1
-  "$bin" render "$d/cloud.cbrk" --res 64x48 --spp 4 -o "$d/cbrk.exr" >/dev/null 2>&1
+  # shellcheck disable=SC2086
+  "$bin" render "$d/cloud.cbrk" --res 64x48 --spp 4 $extra -o "$d/cbrk.exr" >/dev/null 2>&1
   for crop in 0,0,40,48 40,0,64,48; do
-    "$bin" render data/cloud.vdb --res 64x48 --spp 4 --aov depth --crop "$crop" \
+    # shellcheck disable=SC2086
+    "$bin" render data/cloud.vdb --res 64x48 --spp 4 --aov depth --crop "$crop" $extra \
       -o "$d/tile_${crop//,/_}.exr" >/dev/null 2>&1
   done
   "$bin" merge "$d/merged.exr" "$d"/tile_*.exr >/dev/null 2>&1

@@ -51,6 +51,7 @@ pub mod env_map;
 pub mod error;
 pub mod exr_layers;
 pub mod film;
+pub mod guiding;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
@@ -78,6 +79,7 @@ pub use control::RenderControl;
 pub use env_map::EnvMap;
 pub use error::{Error, Result};
 pub use film::{AovImage, Image};
+pub use guiding::GuidingMode;
 pub use integrator::{
     AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, PathTracer, RayMarcher,
     Sample, TwoPassMarcher,

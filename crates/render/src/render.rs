@@ -12,6 +12,7 @@ use crate::camera::Camera;
 use crate::compositing::{DepthHoldout, Layers};
 use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Image, Tile};
+use crate::guiding::{self, Frame, Guide, GuidingMode, GuidingStats, TrainingSchedule};
 use crate::integrator::{
     CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
 };
@@ -88,13 +89,23 @@ fn render_with<M: Media>(
     start: Instant,
 ) -> Rendered {
     let mut counters = Counters::default();
+    let mut guiding_stats = None;
     let lights = lights.clone();
     let (image, aovs, layers, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
-            let s = PathTracer::new(medium, lights, settings.transmittance, settings.max_depth)
-                .with_light_groups(!settings.compositing.light_groups.is_empty());
+            let tracer = PathTracer::new(
+                medium,
+                lights.clone(),
+                settings.transmittance,
+                settings.max_depth,
+            )
+            .with_light_groups(!settings.compositing.light_groups.is_empty());
+            let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
+            guiding_stats = Some(stats);
+            let s = tracer.with_guide(guide.as_ref());
+            let setup = start.elapsed().as_secs_f64();
             let (image, aovs, layers) = run(&s, camera, settings, start, &mut counters);
-            (image, aovs, layers, 0.0)
+            (image, aovs, layers, setup)
         }
         IntegratorKind::RayMarch => {
             let s = RayMarcher::new(medium, lights, settings.step_voxels)
@@ -129,6 +140,7 @@ fn render_with<M: Media>(
         setup_seconds,
         counters,
         rays_per_second: counters.paths as f64 / wall_seconds.max(1e-9),
+        guiding: guiding_stats,
         ..Default::default()
     };
     let crop = crop_of(settings, camera);
@@ -468,3 +480,54 @@ impl Progress {
         }
     }
 }
+
+/// The radiance cache a path-traced render follows, trained as
+/// `settings.guiding` says ([`GuidingMode`]), with its
+/// statistics; `None` when it follows none.
+fn trained_guide<'m, M: Media>(
+    media: &'m M,
+    camera: &Camera,
+    settings: &RenderSettings,
+    tracer: &PathTracer<'m, M>,
+) -> (Option<Guide>, GuidingStats) {
+    let frame = Frame {
+        camera,
+        shutter: settings.shutter,
+        sampler: settings.sampler,
+        seed: settings.seed,
+    };
+    let (on, mode) = match settings.guiding {
+        GuidingMode::Off => (false, "off".to_string()),
+        GuidingMode::On => (true, "on".to_string()),
+        GuidingMode::Auto => (
+            false,
+            "auto: off (guiding pays on no scene measured yet)".to_string(),
+        ),
+    };
+    if !on {
+        return (
+            None,
+            GuidingStats {
+                mode,
+                ..Default::default()
+            },
+        );
+    }
+    let spp = match settings.budget {
+        Budget::Spp(n) => n,
+        Budget::Time(_) => TIMED_TRAINING_SPP,
+    };
+    let (guide, mut stats, _) = guiding::train(
+        media.bounds(),
+        &frame,
+        &TrainingSchedule::for_spp(spp),
+        |guide, ray, draws, c, recorder| {
+            tracer.sample_with(Some(guide), ray, draws, c, recorder);
+        },
+    );
+    stats.mode = mode;
+    (Some(guide), stats)
+}
+
+/// The samples per pixel a time-budgeted render's training is planned for.
+const TIMED_TRAINING_SPP: u32 = 64;

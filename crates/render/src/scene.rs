@@ -10,6 +10,7 @@ use crate::camera::Camera;
 use crate::compositing::Compositing;
 use crate::control::RenderControl;
 use crate::error::{Error, Result};
+use crate::guiding::GuidingMode;
 use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::light::Lights;
 use crate::sampling::SamplerKind;
@@ -109,6 +110,9 @@ pub struct RenderSettings {
     /// Light groups, holdout depth, Cryptomatte and deep samples
     /// ([`crate::compositing`]); the default keeps none.
     pub compositing: Compositing,
+    /// Whether the path tracer learns and follows a radiance cache
+    /// ([`crate::guiding`]).
+    pub guiding: GuidingMode,
 }
 
 /// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
@@ -154,6 +158,7 @@ impl Default for RenderSettings {
             control: None,
             shutter: Shutter::INSTANT,
             compositing: Compositing::default(),
+            guiding: GuidingMode::Auto,
         }
     }
 }

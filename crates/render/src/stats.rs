@@ -107,6 +107,9 @@ pub struct RenderStats {
     pub denoise_seconds: f64,
     /// Camera paths per second of wall time.
     pub rays_per_second: f64,
+    /// What the path tracer's radiance cache was and cost (`None` for
+    /// the marchers).
+    pub guiding: Option<crate::guiding::GuidingStats>,
 }
 
 impl RenderStats {

@@ -8,8 +8,8 @@ use std::sync::Arc;
 use cirrus_render::compositing::deep::{flatten, DeepSample};
 use cirrus_render::compositing::DEFAULT_LIGHT_GROUPS;
 use cirrus_render::{
-    Camera, DepthHoldout, Emission, EnvMap, Environment, GridField, Image,
-    IntegratorKind, Lights, RenderSettings, Rendered, Sun, Medium, Volumes,
+    Camera, DepthHoldout, Emission, EnvMap, Environment, GridField, Image, IntegratorKind, Lights,
+    Medium, RenderSettings, Rendered, Sun, Volumes,
 };
 use glam::Vec3;
 
@@ -42,8 +42,7 @@ fn volumes(glow: bool) -> Volumes<GridField> {
 /// [`volumes`], the blob a holdout if `holdout`.
 fn volumes_with(glow: bool, holdout: bool) -> Volumes<GridField> {
     let cloud = Medium::new(blob(Vec3::ZERO), 12.0, Vec3::splat(0.9), 0.4);
-    let mut ember =
-        Medium::new(blob(Vec3::new(0.45, 0.1, 0.2)), 40.0, Vec3::splat(0.5), 0.0);
+    let mut ember = Medium::new(blob(Vec3::new(0.45, 0.1, 0.2)), 40.0, Vec3::splat(0.5), 0.0);
     ember.holdout = holdout;
     if glow {
         ember.emission = Some(Emission {

@@ -22,7 +22,7 @@ use std::path::PathBuf;
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
+    GuidingMode, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
 };
 
 use crate::description::Colour;
@@ -70,6 +70,7 @@ macro_rules! shown_by_name {
     )*};
 }
 shown_by_name!(
+    GuidingMode,
     IntegratorKind,
     TransmittanceEstimator,
     MajorantMode,

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
+    GuidingMode, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
 };
 use serde::Deserialize;
 
@@ -91,6 +91,11 @@ declare_settings! {
     /// (Mitsuba-like), or whichever a probe of the scene finds cheaper.
     majorant: MajorantMode, flag(long, value_enum), default(MajorantMode::Auto),
         example(MajorantMode::Global);
+    /// Path guiding: learn where the light comes from (a radiance cache
+    /// trained on the frame's own paths) and scatter toward it; `auto`
+    /// guides where that pays, which measured is nowhere yet (on: try it).
+    guiding: GuidingMode, flag(long, value_enum), default(GuidingMode::Auto),
+        example(GuidingMode::On);
     /// Real scattering events per path (0: only the sky through the volume,
     /// 1: single scattering).
     max_depth: u32, flag(long), unset("unlimited, ended by Russian roulette"), example(1);

@@ -50,6 +50,7 @@ impl SceneSettings {
             integrator: r.integrator(),
             transmittance: r.transmittance(),
             majorant: r.majorant(),
+            guiding: r.guiding(),
             budget,
             seed: r.seed(),
             sampler: r.sampler(),

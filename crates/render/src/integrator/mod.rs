@@ -10,6 +10,8 @@
 mod light_grid;
 mod march;
 mod path;
+mod path_light;
+mod path_scatter;
 mod raymarch;
 mod raymarch2pass;
 

@@ -1,17 +1,20 @@
-//! Volumetric path tracing.
+//! Volumetric path tracing: the path loop (`path.rs`), next-event
+//! estimation (`path_light.rs`) and the scattered direction, guided or
+//! not (`path_scatter.rs`).
 
 use glam::Vec3;
 
+use super::path_light::Vertex;
 use super::{escaped_radiance, AovSample, CameraSampler, LightParts, Sample};
 use crate::compositing::{tag, GroupRadiance, LightGroup};
-use crate::light::{LightSample, Lights};
-use crate::medium::Media;
-use crate::phase::Phase;
+use crate::guiding::{Guide, Ignore, Learner};
+use crate::light::Lights;
+use crate::medium::{Interaction, Media};
 use crate::ray::Ray;
-use crate::sampling::{power_heuristic, Draw, Rng, SampleStream};
+use crate::sampling::{Draw, Rng, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::stats::Counters;
-use crate::tracking::{sample_free_flight, transmittance, FreeFlight, TransmittanceEstimator};
+use crate::tracking::{sample_free_flight, FreeFlight, TransmittanceEstimator};
 
 /// Russian roulette on path throughput starts after this many scattering
 /// events...
@@ -56,6 +59,10 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   directions, shadow rays' first optical depths, phase direction and
 ///   roulette as the [`Draw`]s of [`crate::sampling`]'s allocation
 ///   (Sobol points for the first vertices); the rest from the hashed stream.
+/// - Guiding: with a [`Guide`], each scattered direction is drawn from
+///   the mixture of the learned incident light and the phase function
+///   (`path_scatter.rs`); NEE's MIS weights and escaped light's take the
+///   mixture's density. Without one, the phase function alone, as always.
 /// - Emission: at every real collision, with the instance chosen with
 ///   probability `sigma_t,i / sigma_t` ([`Media::interaction`]), the
 ///   path adds `beta * (1 - albedo_i) * Le_i`. Delta tracking samples the
@@ -65,14 +72,15 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   depth test: emission is not a scattering event, so `max_depth` 0 shows
 ///   the emitted light seen through the volume.
 pub struct PathTracer<'a, M> {
-    medium: &'a M,
-    lights: Lights,
-    estimator: TransmittanceEstimator,
+    pub(super) medium: &'a M,
+    pub(super) lights: Lights,
+    pub(super) estimator: TransmittanceEstimator,
     max_depth: Option<u32>,
     chromatic: bool,
     /// Tag contributions with their light groups (off: `Sample::groups`
     /// stays zero and costs nothing).
     light_groups: bool,
+    guide: Option<&'a Guide>,
 }
 
 impl<'a, M: Media> PathTracer<'a, M> {
@@ -89,6 +97,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             max_depth,
             chromatic: medium.chromatic(),
             light_groups: false,
+            guide: None,
         }
     }
 
@@ -100,72 +109,26 @@ impl<'a, M: Media> PathTracer<'a, M> {
         }
     }
 
-    /// NEE at `p`, path vertex `vertex`, for a path arriving along `ray_in`
-    /// (whose time the shadow rays keep).
-    #[allow(clippy::too_many_arguments)]
-    fn direct_light<S: Spectrum>(
-        &self,
-        p: Vec3,
-        ray_in: &Ray,
-        phase: &Phase,
-        mis: bool,
-        vertex: u32,
-        draws: &mut SampleStream,
-        c: &mut Counters,
-    ) -> LightParts {
-        let mut l = LightParts::default();
-        if let Some(sun) = &self.lights.sun {
-            let (u1, u2) = draws.get_2d(Draw::SunDirection, vertex);
-            let s = sun.sample(u1, u2);
-            c.nee_rays_sun += 1;
-            let shadow = (Draw::SunShadow, vertex);
-            l.sun = self.light_term::<S>(p, ray_in, phase, s, mis, shadow, draws, c);
-        }
-        if let Some(env) = &self.lights.environment {
-            let (u1, u2) = draws.get_2d(Draw::SkyDirection, vertex);
-            let s = env.sample(u1, u2);
-            c.env_samples += 1;
-            // A zero-density sample (a pole) is dropped without a shadow ray.
-            c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
-            let shadow = (Draw::SkyShadow, vertex);
-            l.sky = self.light_term::<S>(p, ray_in, phase, s, mis, shadow, draws, c);
-        }
-        l
+    /// Follows `guide` where it has learned.
+    pub fn with_guide(self, guide: Option<&'a Guide>) -> Self {
+        Self { guide, ..self }
     }
 
-    /// `f * Li * T * w / p_light` for one light sample; for a delta light
-    /// `radiance` is the irradiance and the pdf is a delta, so `f * E * T`.
-    #[allow(clippy::too_many_arguments)]
-    fn light_term<S: Spectrum>(
+    /// One camera sample guided by `guide` (instead of the tracer's own),
+    /// its path reported to `learner`: what training passes render.
+    pub fn sample_with(
         &self,
-        p: Vec3,
-        ray_in: &Ray,
-        phase: &Phase,
-        s: LightSample,
-        mis: bool,
-        (draw, vertex): (Draw, u32),
+        guide: Option<&Guide>,
+        camera_ray: Ray,
         draws: &mut SampleStream,
         c: &mut Counters,
-    ) -> Vec3 {
-        let f = phase.eval(ray_in.dir, s.to_light);
-        let weight = match s.pdf {
-            None => f,
-            Some(light_pdf) if light_pdf > 0.0 => {
-                // Every phase function is sampled exactly: its pdf is f.
-                let w = if mis {
-                    power_heuristic(light_pdf, f)
-                } else {
-                    1.0
-                };
-                f * w / light_pdf
-            }
-            Some(_) => return Vec3::ZERO,
-        };
-        let shadow = ray_in.spawn(p, s.to_light);
-        let tr = draws.leading(draw, vertex, |rng| {
-            transmittance::<S, M>(self.estimator, self.medium, &shadow, f32::INFINITY, rng, c)
-        });
-        s.radiance * (weight * tr.rgb())
+        learner: &mut impl Learner,
+    ) -> Sample {
+        if self.chromatic {
+            self.trace::<Vec3>(guide, camera_ray, draws, c, learner)
+        } else {
+            self.trace::<f32>(guide, camera_ray, draws, c, learner)
+        }
     }
 }
 
@@ -178,10 +141,55 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
     }
 
     fn sample_stream(&self, camera_ray: Ray, draws: &mut SampleStream, c: &mut Counters) -> Sample {
-        if self.chromatic {
-            self.trace::<Vec3>(camera_ray, draws, c)
-        } else {
-            self.trace::<f32>(camera_ray, draws, c)
+        self.sample_with(self.guide, camera_ray, draws, c, &mut Ignore)
+    }
+}
+
+/// What the lights at infinity a ray escapes to add.
+#[derive(Clone, Copy, Debug)]
+enum Escape {
+    /// All their light: the camera ray, which no light strategy sampled.
+    Full,
+    /// Weighted against next-event estimation's samples (power
+    /// heuristic): a phase-sampled ray, with the density it had.
+    Mis(f32),
+    /// Nothing: its vertex took them by next-event estimation alone (a
+    /// resampled direction, or the last allowed vertex).
+    None,
+}
+
+/// A camera path as it is traced: what it carries and what it has found.
+struct Path {
+    ray: Ray,
+    beta: Vec3,
+    /// Scattering events so far.
+    depth: u32,
+    /// How the lights at infinity the current ray escapes to count.
+    escape: Escape,
+    /// Set after the last allowed scattering event when the media emit:
+    /// the path goes on only to find emitted light, lights at infinity
+    /// having had their full weight from next-event estimation.
+    emission_only: bool,
+    out: Sample,
+}
+
+impl Path {
+    /// Adds light `parts` reaching the path (throughput included in
+    /// `total`), to the pixel, its light groups and the learner.
+    #[inline]
+    fn add(
+        &mut self,
+        total: Vec3,
+        parts: Option<LightParts>,
+        groups: bool,
+        learner: &mut impl Learner,
+    ) {
+        self.out.radiance += total;
+        learner.contribute(total);
+        if groups {
+            if let Some(parts) = parts {
+                parts.scaled(self.beta).tag(&mut self.out.groups);
+            }
         }
     }
 }
@@ -190,125 +198,180 @@ impl<M: Media> PathTracer<'_, M> {
     /// One camera path, tracked per channel of `S`.
     fn trace<S: Spectrum>(
         &self,
+        guide: Option<&Guide>,
         camera_ray: Ray,
         draws: &mut SampleStream,
         c: &mut Counters,
+        learner: &mut impl Learner,
     ) -> Sample {
         c.paths += 1;
-        let emits = self.medium.emits();
-        let mut ray = camera_ray;
-        let mut beta = Vec3::ONE;
-        let mut l = Vec3::ZERO;
-        let mut alpha = 0.0;
-        let mut aov = AovSample::default();
-        let mut groups = GroupRadiance::default();
-        let mut depth = 0u32;
-        let mut phase_pdf = None;
-        // Set after the last allowed scattering event when the media emit:
-        // the path goes on only to find emitted light, lights at infinity
-        // having had their full weight from next-event estimation.
-        let mut emission_only = false;
+        let mut path = Path {
+            ray: camera_ray,
+            beta: Vec3::ONE,
+            depth: 0,
+            escape: Escape::Full,
+            emission_only: false,
+            out: Sample {
+                radiance: Vec3::ZERO,
+                alpha: 0.0,
+                aov: AovSample::default(),
+                groups: GroupRadiance::default(),
+            },
+        };
         loop {
             // This free flight and the events at its collision are path
             // vertex `vertex` of the draw allocation.
-            let vertex = depth;
+            let vertex = path.depth;
+            let ray = path.ray;
             let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
-                sample_free_flight::<S, M>(self.medium, &ray, ray.t_max, &mut beta, rng, c)
+                sample_free_flight::<S, M>(self.medium, &ray, ray.t_max, &mut path.beta, rng, c)
             });
-            if depth == 0 {
-                alpha = match flight {
-                    FreeFlight::Escaped => S::escaped_alpha(beta),
+            if path.depth == 0 {
+                path.out.alpha = match flight {
+                    FreeFlight::Escaped => S::escaped_alpha(path.beta),
                     _ => 1.0,
                 };
             }
             let t = match flight {
-                FreeFlight::Escaped if emission_only => break,
-                // A camera ray ended by a depth holdout: what lies behind
-                // the held-out geometry, the sky included, never shows.
-                FreeFlight::Escaped if ray.t_max.is_finite() => break,
                 FreeFlight::Escaped => {
-                    let parts = escaped_radiance(&self.lights, ray.dir, phase_pdf, c);
-                    let e = beta * parts.total();
-                    if self.light_groups {
-                        parts.scaled(beta).tag(&mut groups);
-                    }
-                    l += e;
-                    if depth == 1 {
-                        aov.direct += e;
-                    }
+                    self.escape(&mut path, c, learner);
                     break;
                 }
                 FreeFlight::Capped => break,
                 FreeFlight::Collision { t } => t,
             };
-            let p = ray.at(t);
-            let it = self.medium.interaction(p, ray.time, draws.rng());
-            if S::CHROMATIC {
-                beta *= it.weight;
-            }
-            if depth == 0 {
-                // A holdout volume seen first is a matte: no light, no alpha.
-                if it.holdout {
-                    alpha = 0.0;
-                    break;
-                }
-                aov.albedo = it.albedo;
-                aov.depth = Some(t);
-                aov.instance = Some(it.instance);
-            }
-            if emits {
-                let e = beta
-                    * (Vec3::ONE - it.albedo)
-                    * self.medium.emission(p, ray.time, it.instance, c);
-                l += e;
-                aov.emission += e;
-                if self.light_groups {
-                    tag(&mut groups, LightGroup::Emission, e);
-                }
-            }
-            if self.max_depth == Some(depth) {
+            if !self.collide::<S>(&mut path, guide, t, vertex, draws, c, learner) {
                 break;
             }
-            depth += 1;
-            beta *= it.albedo;
-            if beta.max_element() <= 0.0 {
-                break;
+        }
+        learner.finish();
+        path.out
+    }
+
+    /// The path left the media: the lights at infinity it reaches.
+    fn escape(&self, path: &mut Path, c: &mut Counters, learner: &mut impl Learner) {
+        // A camera ray ended by a depth holdout: what lies behind the
+        // held-out geometry, the sky included, never shows.
+        let pdf = match path.escape {
+            _ if path.emission_only || path.ray.t_max.is_finite() => return,
+            Escape::None => return,
+            Escape::Full => None,
+            Escape::Mis(pdf) => Some(pdf),
+        };
+        let parts = escaped_radiance(&self.lights, path.ray.dir, pdf, c);
+        let e = path.beta * parts.total();
+        path.add(e, Some(parts), self.light_groups, learner);
+        if path.depth == 1 {
+            path.out.aov.direct += e;
+        }
+    }
+
+    /// The events at a real collision at `t`: emission, next-event
+    /// estimation and the scattered direction. Returns false when the path
+    /// ends there.
+    #[allow(clippy::too_many_arguments)]
+    fn collide<S: Spectrum>(
+        &self,
+        path: &mut Path,
+        guide: Option<&Guide>,
+        t: f32,
+        vertex: u32,
+        draws: &mut SampleStream,
+        c: &mut Counters,
+        learner: &mut impl Learner,
+    ) -> bool {
+        let p = path.ray.at(t);
+        let it = self.medium.interaction(p, path.ray.time, draws.rng());
+        if S::CHROMATIC {
+            path.beta *= it.weight;
+        }
+        if path.depth == 0 {
+            // A holdout volume seen first is a matte: no light, no alpha.
+            if it.holdout {
+                path.out.alpha = 0.0;
+                return false;
             }
-            let last = self.max_depth == Some(depth);
-            let parts = self.direct_light::<S>(p, &ray, it.phase, !last, vertex, draws, c);
-            let direct = beta * parts.total();
-            if self.light_groups {
-                parts.scaled(beta).tag(&mut groups);
+            let aov = &mut path.out.aov;
+            aov.albedo = it.albedo;
+            aov.depth = Some(t);
+            aov.instance = Some(it.instance);
+        }
+        if self.medium.emits() {
+            self.emit(path, p, &it, c, learner);
+        }
+        if self.max_depth == Some(path.depth) {
+            return false;
+        }
+        path.depth += 1;
+        path.beta *= it.albedo;
+        if path.beta.max_element() <= 0.0 {
+            return false;
+        }
+        let last = self.max_depth == Some(path.depth);
+        let region = guide.map(|g| g.region_at(p));
+        let light = region.and_then(|(_, r)| r.light());
+        let ray_in = path.ray;
+        let v = Vertex {
+            p,
+            ray_in: &ray_in,
+            phase: it.phase,
+            mis: !last && light.is_none(),
+            index: vertex,
+        };
+        let parts = self.direct_light::<S>(&v, draws, c);
+        let direct = path.beta * parts.total();
+        path.add(direct, Some(parts), self.light_groups, learner);
+        if path.depth == 1 {
+            path.out.aov.direct += direct;
+        }
+        if last {
+            if !self.medium.emits() {
+                return false;
             }
-            l += direct;
-            if depth == 1 {
-                aov.direct += direct;
-            }
-            if last {
-                if !emits {
-                    break;
+            path.emission_only = true;
+        }
+        let s = self.scatter(&ray_in, it.phase, light, vertex, draws);
+        if light.is_some() {
+            path.beta *= s.weight;
+        }
+        path.escape = s.pdf.map_or(Escape::None, Escape::Mis);
+        path.ray = ray_in.spawn(p, s.dir);
+        if let Some((index, _)) = region {
+            learner.scatter(index, s.dir, s.weight, path.beta, parts.total());
+        }
+        self.roulette(path, vertex, draws)
+    }
+
+    /// `beta * (1 - albedo) * Le`: the emission term at a collision.
+    fn emit(
+        &self,
+        path: &mut Path,
+        p: Vec3,
+        it: &Interaction,
+        c: &mut Counters,
+        learner: &mut impl Learner,
+    ) {
+        let le = self.medium.emission(p, path.ray.time, it.instance, c);
+        let e = path.beta * (Vec3::ONE - it.albedo) * le;
+        path.add(e, None, false, learner);
+        path.out.aov.emission += e;
+        if self.light_groups {
+            tag(&mut path.out.groups, LightGroup::Emission, e);
+        }
+    }
+
+    /// Russian roulette on the throughput once it is small; false when the
+    /// path ends.
+    fn roulette(&self, path: &mut Path, vertex: u32, draws: &mut SampleStream) -> bool {
+        if path.depth >= ROULETTE_MIN_DEPTH {
+            let m = path.beta.max_element();
+            if m < ROULETTE_THROUGHPUT {
+                if draws.get_1d(Draw::Roulette, vertex) >= m {
+                    return false;
                 }
-                emission_only = true;
-            }
-            let (u1, u2) = draws.get_2d(Draw::Phase, vertex);
-            let (dir, pdf) = it.phase.sample(ray.dir, u1, u2);
-            phase_pdf = Some(pdf);
-            ray = ray.spawn(p, dir);
-            if depth >= ROULETTE_MIN_DEPTH {
-                let m = beta.max_element();
-                if m < ROULETTE_THROUGHPUT {
-                    if draws.get_1d(Draw::Roulette, vertex) >= m {
-                        break;
-                    }
-                    beta /= m;
-                }
+                path.beta /= m;
             }
         }
-        Sample {
-            radiance: l,
-            alpha,
-            aov,
-            groups,
-        }
+        true
     }
 }
