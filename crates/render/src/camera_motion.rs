@@ -8,6 +8,7 @@
 
 use glam::{Quat, Vec3};
 
+use crate::error::{Error, Result};
 use crate::ray::Ray;
 
 /// The most poses one shutter holds.
@@ -31,15 +32,17 @@ pub struct CameraMotion {
 
 impl CameraMotion {
     /// Poses at increasing, finite times; 1 to [`MAX_POSES`] of them.
-    pub fn new(samples: &[(f32, CameraPose)]) -> Result<CameraMotion, String> {
+    pub fn new(samples: &[(f32, CameraPose)]) -> Result<CameraMotion> {
         if samples.is_empty() || samples.len() > MAX_POSES {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "a moving camera takes 1 to {MAX_POSES} poses, got {}",
                 samples.len()
-            ));
+            )));
         }
         if samples.windows(2).any(|w| !(w[1].0 > w[0].0)) || !samples[0].0.is_finite() {
-            return Err("camera pose times must be finite and increasing".into());
+            return Err(Error::invalid(
+                "camera pose times must be finite and increasing",
+            ));
         }
         let still = CameraPose {
             position: Vec3::ZERO,

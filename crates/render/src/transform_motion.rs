@@ -16,6 +16,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 
+use crate::error::{Error, Result};
 use crate::medium::{Bounds3, DensityField, Lattice};
 
 /// Render-space maps from a shutter time's placement to the still one,
@@ -30,15 +31,15 @@ pub struct PoseTable {
 impl PoseTable {
     /// `maps[k]` at time `open + k (close - open) / (maps.len() - 1)`; at
     /// least two maps and `close > open`.
-    pub fn new(open: f32, close: f32, maps: Vec<Mat4>) -> Result<PoseTable, String> {
+    pub fn new(open: f32, close: f32, maps: Vec<Mat4>) -> Result<PoseTable> {
         if maps.len() < 2 || !(close > open) || !open.is_finite() || !close.is_finite() {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "a pose table needs two or more maps over open < close, got {} over [{open}, {close}]",
                 maps.len()
-            ));
+            )));
         }
         if maps.iter().any(|m| !m.is_finite()) {
-            return Err("a pose table's maps must be finite".into());
+            return Err(Error::invalid("a pose table's maps must be finite"));
         }
         let step = (close - open) / (maps.len() - 1) as f32;
         Ok(PoseTable { open, step, maps })

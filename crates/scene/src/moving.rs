@@ -68,9 +68,7 @@ impl Track {
             .iter()
             .map(|m| (to_render * self.still * m.inverse() * to_world).as_mat4())
             .collect();
-        PoseTable::new(self.open, self.close, maps)
-            .map(Arc::new)
-            .map_err(Error::input)
+        Ok(Arc::new(PoseTable::new(self.open, self.close, maps)?))
     }
 
     /// `world_box` (the still placement's) grown to every pose's.
@@ -223,7 +221,7 @@ pub fn camera(desc: &SceneDescription, s: &SceneSettings, centre: DVec3) -> Resu
                 )
             })
             .collect();
-        camera = camera.with_motion(CameraMotion::new(&poses).map_err(Error::input)?);
+        camera = camera.with_motion(CameraMotion::new(&poses)?);
     }
     // The far plane is not clipped: rays end where the medium does.
     if let Some([near, _far]) = c.clipping {
