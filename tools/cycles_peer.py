@@ -23,7 +23,8 @@ flags of `cirrus render` with the same meanings and builds the same scene in Cyc
              max_bounces and volume_bounces = cirrus --max-depth - 1 (one scattering event is
              Cycles' volume bounce 0) or 1024 for unlimited, film not transparent (the sky is
              seen through the volume, as in cirrus's RGB), view transform Standard, exposure 0,
-             denoising off unless --denoise (OIDN, albedo-guided like cirrus --denoise)
+             denoising off unless --denoise (OIDN, albedo-guided like cirrus --denoise), path
+             guiding off unless --guiding (OpenPGL, volume guiding on, surface guiding off)
     output   EXR float32 linear RGBA (alpha is 1: compare RGB; cirrus's alpha is 1 - T)
 
 Needs Blender's `bpy` module (PyPI bpy 5.2.3 is for CPython 3.13):
@@ -138,6 +139,9 @@ def parse_args(argv=None):
     ap.add_argument("--denoise", action="store_true",
                     help="Cycles' OIDN denoiser with the albedo pass as guide (prefilter ACCURATE)")
     ap.add_argument("--denoise-passes", default="RGB_ALBEDO", help="denoising_input_passes")
+    ap.add_argument("--guiding", action="store_true",
+                    help="Cycles' OpenPGL path guiding for volumes (use_guiding, use_volume_guiding; surface "
+                         "guiding off, training samples and the rest at Blender's defaults)")
     ap.add_argument("--keep-half", action="store_true",
                     help="keep Blender's default half-float volume precision (default: FULL)")
     ap.add_argument("--json", default=None, help="write per-render timings and the scene as JSON")
@@ -251,7 +255,13 @@ def build_scene(args):
     cy.volume_biased = False  # null-scattering (unbiased) volumes; True is ray marching
     cy.pixel_filter_type = "BOX"  # default Blackman-Harris 1.5 px
     cy.filter_width = 1.0
-    cy.use_guiding = False
+    # OpenPGL guiding learns from the render's first samples (guiding_training_samples, Blender's
+    # default kept) and guides volume scattering directions: the second Cycles configuration a
+    # thick bright cloud is measured against (the better of the two is the peer).
+    cy.use_guiding = bool(args.guiding)
+    if args.guiding:
+        cy.use_volume_guiding = True
+        cy.use_surface_guiding = False
     if args.max_depth is None:
         bounces = UNLIMITED_BOUNCES
     else:

@@ -25,7 +25,9 @@ variances summed: pixels are independent), the fraction of pixels with |z| > 3 a
 against the fraction Student's t predicts from noise alone, and 8x8-block z-scores.
 Pixels with no noise in either renderer (sky beside the cloud) must agree to 1e-4.
 
-`efficiency`: one scene (HG g 0.5, albedo 0.9, sun 0.53 deg + sky, unlimited depth); a
+`efficiency`: one scene (`--scene sunsky`: HG g 0.5, albedo 0.9, sun 0.53 deg + sky, unlimited
+depth; `--scene thick`: albedo 0.999, HG g 0.8, a delta sun + sky), cirrus in one or more labelled
+configurations (`--cirrus-config`), Cycles unguided and, with `--cycles-guiding`, guided; a
 converged reference from two long cirrus renders with other seeds (its own noise, estimated
 from their difference, is subtracted from every MSE); each renderer at several spp, unbiased
 and with OIDN (cirrus --denoise, Cycles' OIDN with the albedo pass); MSE, wall and CPU
@@ -404,9 +406,19 @@ def channel_table(results: dict) -> str:
 # --------------------------------------------------------------------------- efficiency
 
 EFF_FLAGS = VIEW + SUN + ["--sun-angle", "0.53", "--phase", "hg", "--g", "0.5"]
+# A thick, bright cloud, the regime of production cumulus: the same cloud (optical depth ~24
+# through its core), albedo 0.999, HG g 0.8, a delta sun and the sky.
+THICK_FLAGS = [f for f in VIEW] + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.8"]
+THICK_FLAGS[THICK_FLAGS.index("--albedo") + 1] = "0.999"
+SCENES = {"sunsky": EFF_FLAGS, "thick": THICK_FLAGS}
 
 
 def efficiency(args) -> int:
+    flags = SCENES[args.scene]
+    # Labelled configurations: cirrus's (label=extra flags) and Cycles' (unguided, and guided
+    # with --cycles-guiding: the better of the two is the peer).
+    cirrus_configs = [c.split("=", 1) for c in args.cirrus_config] or [["cirrus", ""]]
+    cycles_configs = [["cycles", []]] + ([["cycles-guided", ["--guiding"]]] if args.cycles_guiding else [])
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     R = Renderers(args)
@@ -423,7 +435,7 @@ def efficiency(args) -> int:
     for s in (1001, 1002):
         f = out / f"ref_{s}.exr"
         if not f.exists():
-            t = R.cirrus_run(EFF_FLAGS, f, ref_spp, s)
+            t = R.cirrus_run(flags, f, ref_spp, s)
             res.setdefault("reference_timing", []).append({x: y for x, y in t.items() if x != "stdout"})
             save()
         refs.append(read_rgb(f))
@@ -460,29 +472,32 @@ def efficiency(args) -> int:
             f"{wall:.1f} s wall, load {t['load_before']:.1f}->{t['load_after']:.1f}")
 
     for denoise in ([False, True] if not args.no_denoise else [False]):
-        for spp in args.cirrus_spp:
-            if ("cirrus", spp, denoise) in done:
-                continue
-            f = out / f"cirrus_{spp}{'_dn' if denoise else ''}.exr"
-            extra = ["--denoise"] if denoise else []
-            if denoise and not oidn:
-                raise SystemExit("set CIRRUS_OIDN=$(bash tools/oidn.sh /work/peer/oidn-venv/bin/python) for --denoise")
-            t = R.cirrus_run(EFF_FLAGS, f, spp, 7, extra=extra, env=env)
-            record("cirrus", spp, denoise, f, t)
-        for spp in args.cycles_spp:
-            if ("cycles", spp, denoise) in done:
-                continue
-            pattern = out / f"cycles_{spp}{'_dn' if denoise else ''}_{{seed}}.exr"
-            t = R.cycles_runs(EFF_FLAGS, pattern, spp, [7], extra=["--denoise"] if denoise else [])
-            record("cycles", spp, denoise, Path(str(pattern).replace("{seed}", "7")), t,
-                   cycles_render=t["cycles"]["renders"][0])
+        for label, extra_flags in cirrus_configs:
+            for spp in args.cirrus_spp:
+                if (label, spp, denoise) in done:
+                    continue
+                f = out / f"{label}_{spp}{'_dn' if denoise else ''}.exr"
+                extra = extra_flags.split() + (["--denoise"] if denoise else [])
+                if denoise and not oidn:
+                    raise SystemExit("set CIRRUS_OIDN=$(bash tools/oidn.sh /work/peer/oidn-venv/bin/python) for --denoise")
+                t = R.cirrus_run(flags, f, spp, 7, extra=extra, env=env)
+                record(label, spp, denoise, f, t)
+        for label, extra_flags in cycles_configs:
+            for spp in args.cycles_spp:
+                if (label, spp, denoise) in done:
+                    continue
+                pattern = out / f"{label}_{spp}{'_dn' if denoise else ''}_{{seed}}.exr"
+                extra = extra_flags + (["--denoise"] if denoise else [])
+                t = R.cycles_runs(flags, pattern, spp, [7], extra=extra)
+                record(label, spp, denoise, Path(str(pattern).replace("{seed}", "7")), t,
+                       cycles_render=t["cycles"]["renders"][0])
     # Fixed costs: a 1-spp render of each.
     if "fixed" not in res:
         f = out / "cycles_fixed_{seed}.exr"
-        t = R.cycles_runs(EFF_FLAGS, f, 1, [7, 8, 9])
+        t = R.cycles_runs(flags, f, 1, [7, 8, 9])
         rr = t["cycles"]["renders"]
         fc = out / "cirrus_fixed.exr"
-        tc = R.cirrus_run(EFF_FLAGS, fc, 1, 7)
+        tc = R.cirrus_run(flags, fc, 1, 7)
         res["fixed"] = {"cycles_1spp_wall": [r["wall_seconds"] for r in rr],
                         "cycles_1spp_cpu": [r["cpu_seconds"] for r in rr],
                         "cycles_process_wall": t["wall"], "cycles_build_seconds": t["cycles"]["build_seconds"],
@@ -539,6 +554,13 @@ def main(argv=None) -> int:
     e.add_argument("--cirrus-spp", type=int, nargs="+", default=[64, 256, 1024])
     e.add_argument("--cycles-spp", type=int, nargs="+", default=[16, 64, 256])
     e.add_argument("--no-denoise", action="store_true")
+    e.add_argument("--scene", choices=list(SCENES), default="sunsky",
+                   help="sunsky: HG g 0.5, albedo 0.9, sun 0.53 deg + sky; thick: albedo 0.999, HG g 0.8, delta sun + sky")
+    e.add_argument("--cirrus-config", action="append", default=[], metavar="LABEL=FLAGS",
+                   help="a cirrus configuration to measure (repeatable), e.g. 'cirrus-one=--light-sampling one'; "
+                        "default: cirrus with its defaults")
+    e.add_argument("--cycles-guiding", action="store_true",
+                   help="also measure Cycles with its OpenPGL volume guiding (cycles_peer.py --guiding)")
     e.add_argument("--refs-only", action="store_true", help="render the reference only (not timing-sensitive)")
     sub.add_parser("list", help="print the cases")
     args = ap.parse_args(argv)

@@ -10,11 +10,14 @@
 //! tracking + ratio tracking over one global majorant) at the same budget.
 //!
 //! Beside the estimators and structures (all with the default Sobol
-//! sampler), three configurations of the default one show what the
-//! sampler, adaptive sampling and denoising each give: independent random
-//! numbers instead of Sobol points, adaptive sampling at
-//! `--noise-threshold`, and Open Image Denoise on the finished image (its
-//! time counted; left out, with a note, where the library does not load).
+//! sampler), configurations of the default one show what the sampler,
+//! adaptive sampling, guiding, light selection and denoising each give:
+//! independent random numbers instead of Sobol points, adaptive sampling
+//! at `--noise-threshold`, path guiding (`--guiding on`, its training
+//! counted in the time), a shadow ray to every light at each vertex
+//! (`--light-sampling all`) instead of to one,
+//! and Open Image Denoise on the finished image (its time counted; left
+//! out, with a note, where the library does not load).
 
 mod ceiling;
 
@@ -22,8 +25,8 @@ use crate::fixed_grid::FixedGridField;
 use crate::BenchResult;
 use ceiling::CollisionCost;
 use cirrus_render::{
-    render, Adaptive, Budget, IntegratorKind, MajorantMode, Medium, RenderSettings, SamplerKind,
-    Scene, TransmittanceEstimator, Volumes,
+    render, Adaptive, Budget, GuidingMode, IntegratorKind, LightSampling, MajorantMode, Medium,
+    RenderSettings, SamplerKind, Scene, TransmittanceEstimator, Volumes,
 };
 use cirrus_scene::{Scene as SceneFile, SceneFlags, VolumeCache};
 use std::fmt::Write as _;
@@ -90,6 +93,8 @@ struct Config {
     sampler: SamplerKind,
     adaptive: Option<Adaptive>,
     denoise: bool,
+    guiding: GuidingMode,
+    light_sampling: LightSampling,
 }
 
 impl Config {
@@ -104,6 +109,8 @@ impl Config {
             sampler: SamplerKind::Sobol,
             adaptive: None,
             denoise: false,
+            guiding: GuidingMode::Off,
+            light_sampling: LightSampling::default(),
         }
     }
 }
@@ -165,6 +172,14 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
             min_spp: cirrus_scene::description::RenderSpec::default().min_spp(),
         }),
         ..default(&format!("adaptive {}%", 100.0 * args.adaptive_threshold))
+    });
+    v.push(Config {
+        guiding: GuidingMode::On,
+        ..default("guided")
+    });
+    v.push(Config {
+        light_sampling: LightSampling::All,
+        ..default("every light per vertex")
     });
     match cirrus_scene::denoise_available() {
         Ok(()) => v.push(Config {
@@ -277,6 +292,8 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
         sampler: c.sampler,
         adaptive: c.adaptive,
         aovs: c.denoise,
+        guiding: c.guiding,
+        light_sampling: c.light_sampling,
         progress: false,
         ..base.clone()
     };

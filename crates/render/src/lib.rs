@@ -81,8 +81,8 @@ pub use error::{Error, Result};
 pub use film::{AovImage, Image};
 pub use guiding::GuidingMode;
 pub use integrator::{
-    AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, PathTracer, RayMarcher,
-    Sample, TwoPassMarcher,
+    AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, LightSampling,
+    PathTracer, RayMarcher, Sample, TwoPassMarcher,
 };
 pub use light::{Environment, Lights, Sun};
 pub use medium::{

@@ -119,12 +119,15 @@ fn probe<M: Media>(
     settings: &RenderSettings,
     limit: f64,
 ) -> ProbeCost {
+    // The render's own light sampling: one light per vertex halves the
+    // shadow rays, which shifts the balance between the structures.
     let tracer = PathTracer::new(
         media,
         lights.clone(),
         settings.transmittance,
         settings.max_depth,
-    );
+    )
+    .with_light_sampling(settings.light_sampling);
     let (w, h) = (camera.width().max(1), camera.height().max(1));
     let pixels = u64::from(w) * u64::from(h);
     // Each path has its own numbers and counts add, so the sum is the same

@@ -14,7 +14,7 @@ use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Image, Tile};
 use crate::guiding::{self, Frame, Guide, GuidingMode, GuidingStats, TrainingSchedule};
 use crate::integrator::{
-    CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
+    CameraSampler, IntegratorKind, LightGrid, LightSampling, PathTracer, RayMarcher, TwoPassMarcher,
 };
 use crate::light::Lights;
 use crate::majorant_choice;
@@ -91,6 +91,16 @@ fn render_with<M: Media>(
     let mut counters = Counters::default();
     let mut guiding_stats = None;
     let lights = lights.clone();
+    let light_sampling = match (settings.integrator, settings.light_sampling) {
+        (IntegratorKind::Path, LightSampling::Auto) => {
+            format!(
+                "auto: {}",
+                LightSampling::Auto.resolve(&lights.clone().pruned()).name()
+            )
+        }
+        (IntegratorKind::Path, mode) => mode.name().into(),
+        _ => String::new(),
+    };
     let (image, aovs, layers, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
             let tracer = PathTracer::new(
@@ -99,7 +109,8 @@ fn render_with<M: Media>(
                 settings.transmittance,
                 settings.max_depth,
             )
-            .with_light_groups(!settings.compositing.light_groups.is_empty());
+            .with_light_groups(!settings.compositing.light_groups.is_empty())
+            .with_light_sampling(settings.light_sampling);
             let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
             guiding_stats = Some(stats);
             let s = tracer.with_guide(guide.as_ref());
@@ -141,6 +152,7 @@ fn render_with<M: Media>(
         counters,
         rays_per_second: counters.paths as f64 / wall_seconds.max(1e-9),
         guiding: guiding_stats,
+        light_sampling,
         ..Default::default()
     };
     let crop = crop_of(settings, camera);

@@ -11,6 +11,7 @@ use crate::compositing::Compositing;
 use crate::control::RenderControl;
 use crate::error::{Error, Result};
 use crate::guiding::GuidingMode;
+use crate::integrator::LightSampling;
 use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::light::Lights;
 use crate::sampling::SamplerKind;
@@ -113,6 +114,9 @@ pub struct RenderSettings {
     /// Whether the path tracer learns and follows a radiance cache
     /// ([`crate::guiding`]).
     pub guiding: GuidingMode,
+    /// Whether next-event estimation samples every light at each vertex,
+    /// or one ([`LightSampling`]).
+    pub light_sampling: LightSampling,
 }
 
 /// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
@@ -159,6 +163,7 @@ impl Default for RenderSettings {
             shutter: Shutter::INSTANT,
             compositing: Compositing::default(),
             guiding: GuidingMode::Auto,
+            light_sampling: LightSampling::Auto,
         }
     }
 }

@@ -82,6 +82,9 @@ pub struct RenderStats {
     /// hierarchy and the global bound, in tentative collisions
     /// ([`crate::majorant_choice`]).
     pub majorant_probe: Option<[f64; 2]>,
+    /// The path tracer's next-event estimation: "all" or "one", with
+    /// `auto` the choice ("auto: one"); empty for the marchers.
+    pub light_sampling: String,
     pub width: u32,
     pub height: u32,
     /// Samples per pixel actually taken (with a time budget: reached).

@@ -22,7 +22,8 @@ use std::path::PathBuf;
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    GuidingMode, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
+    GuidingMode, IntegratorKind, LightSampling, MajorantMode, SamplerKind, TransmittanceEstimator,
+    VelocityUnit,
 };
 
 use crate::description::Colour;
@@ -71,6 +72,7 @@ macro_rules! shown_by_name {
 }
 shown_by_name!(
     GuidingMode,
+    LightSampling,
     IntegratorKind,
     TransmittanceEstimator,
     MajorantMode,

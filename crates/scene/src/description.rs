@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    GuidingMode, IntegratorKind, MajorantMode, SamplerKind, TransmittanceEstimator, VelocityUnit,
+    GuidingMode, IntegratorKind, LightSampling, MajorantMode, SamplerKind, TransmittanceEstimator,
+    VelocityUnit,
 };
 use serde::Deserialize;
 
@@ -96,6 +97,12 @@ declare_settings! {
     /// guides where that pays, which measured is nowhere yet (on: try it).
     guiding: GuidingMode, flag(long, value_enum), default(GuidingMode::Auto),
         example(GuidingMode::On);
+    /// Next-event estimation at each scattering vertex: a shadow ray to
+    /// one light picked by its unoccluded in-scattered light there (half
+    /// the shadow rays under a sun and a sky), or to every light; `auto`
+    /// picks one under a sun and a constant sky, every light under a map.
+    light_sampling: LightSampling, flag(long, value_enum), default(LightSampling::Auto),
+        example(LightSampling::All);
     /// Real scattering events per path (0: only the sky through the volume,
     /// 1: single scattering).
     max_depth: u32, flag(long), unset("unlimited, ended by Russian roulette"), example(1);

@@ -51,6 +51,7 @@ impl SceneSettings {
             transmittance: r.transmittance(),
             majorant: r.majorant(),
             guiding: r.guiding(),
+            light_sampling: r.light_sampling(),
             budget,
             seed: r.seed(),
             sampler: r.sampler(),

@@ -176,7 +176,7 @@ mod tests {
         let (reference, se_ref) = mean_se(n, || {
             f(phase.sample(dir_in, rng.uniform(), rng.uniform()).0)
         });
-        let mut guided = |broken: bool| {
+        let guided = |broken: bool| {
             let mut rng = Rng::new(4, 0, 0);
             mean_se(n, || {
                 let dirs: [Vec3; CANDIDATES] =

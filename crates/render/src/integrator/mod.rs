@@ -7,6 +7,7 @@
 //!   in a sparse grid (`light_grid`) and camera rays marched through it.
 //! - `march`: the jittered fixed-step quadrature both marchers share.
 
+mod light_choice;
 mod light_grid;
 mod march;
 mod path;
@@ -15,6 +16,7 @@ mod path_scatter;
 mod raymarch;
 mod raymarch2pass;
 
+pub use light_choice::LightSampling;
 pub use light_grid::{LightGrid, LightGridSettings};
 pub use path::PathTracer;
 pub use raymarch::RayMarcher;
@@ -28,6 +30,7 @@ use crate::light::Lights;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Rng, SampleStream};
 use crate::stats::Counters;
+use light_choice::LightChoice;
 
 /// Which integrator renders the image.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -121,18 +124,24 @@ pub trait CameraSampler: Sync {
 pub(crate) fn escaped_radiance(
     lights: &Lights,
     dir: Vec3,
-    phase_pdf: Option<f32>,
+    phase_pdf: Option<(f32, LightChoice)>,
     c: &mut Counters,
 ) -> LightParts {
-    let weight = |light_pdf: f32| phase_pdf.map_or(1.0, |p| power_heuristic(p, light_pdf));
+    // The light strategy's density is the light's own times the
+    // probability that the vertex picked it (`light_choice.rs`).
+    let weight = |light_pdf: f32, pick: fn(LightChoice) -> f32| {
+        phase_pdf.map_or(1.0, |(p, choice)| {
+            power_heuristic(p, pick(choice) * light_pdf)
+        })
+    };
     let mut l = LightParts::default();
     if let Some(env) = &lights.environment {
         c.env_samples += 1;
         let (radiance, pdf) = env.eval(dir);
-        l.sky = radiance * weight(pdf);
+        l.sky = radiance * weight(pdf, |c| c.sky);
     }
     if let Some((radiance, pdf)) = lights.sun.as_ref().and_then(|s| s.hit(dir)) {
-        l.sun = radiance * weight(pdf);
+        l.sun = radiance * weight(pdf, |c| c.sun);
     }
     l
 }

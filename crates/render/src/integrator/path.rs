@@ -4,6 +4,7 @@
 
 use glam::Vec3;
 
+use super::light_choice::{LightChoice, LightSampling};
 use super::path_light::Vertex;
 use super::{escaped_radiance, AovSample, CameraSampler, LightParts, Sample};
 use crate::compositing::{tag, GroupRadiance, LightGroup};
@@ -81,6 +82,7 @@ pub struct PathTracer<'a, M> {
     /// stays zero and costs nothing).
     light_groups: bool,
     guide: Option<&'a Guide>,
+    light_sampling: LightSampling,
 }
 
 impl<'a, M: Media> PathTracer<'a, M> {
@@ -90,9 +92,11 @@ impl<'a, M: Media> PathTracer<'a, M> {
         estimator: TransmittanceEstimator,
         max_depth: Option<u32>,
     ) -> Self {
+        let lights = lights.pruned();
         Self {
             medium,
-            lights: lights.pruned(),
+            light_sampling: LightSampling::default().resolve(&lights),
+            lights,
             estimator,
             max_depth,
             chromatic: medium.chromatic(),
@@ -105,6 +109,14 @@ impl<'a, M: Media> PathTracer<'a, M> {
     pub fn with_light_groups(self, light_groups: bool) -> Self {
         Self {
             light_groups,
+            ..self
+        }
+    }
+
+    /// Samples every light at each vertex, or one ([`LightSampling`]).
+    pub fn with_light_sampling(self, light_sampling: LightSampling) -> Self {
+        Self {
+            light_sampling: light_sampling.resolve(&self.lights),
             ..self
         }
     }
@@ -151,8 +163,9 @@ enum Escape {
     /// All their light: the camera ray, which no light strategy sampled.
     Full,
     /// Weighted against next-event estimation's samples (power
-    /// heuristic): a phase-sampled ray, with the density it had.
-    Mis(f32),
+    /// heuristic): a phase-sampled ray, with the density it had and the
+    /// lights' pick probabilities at its vertex.
+    Mis(f32, LightChoice),
     /// Nothing: its vertex took them by next-event estimation alone (a
     /// resampled direction, or the last allowed vertex).
     None,
@@ -256,7 +269,7 @@ impl<M: Media> PathTracer<'_, M> {
             _ if path.emission_only || path.ray.t_max.is_finite() => return,
             Escape::None => return,
             Escape::Full => None,
-            Escape::Mis(pdf) => Some(pdf),
+            Escape::Mis(pdf, choice) => Some((pdf, choice)),
         };
         let parts = escaped_radiance(&self.lights, path.ray.dir, pdf, c);
         let e = path.beta * parts.total();
@@ -317,6 +330,7 @@ impl<M: Media> PathTracer<'_, M> {
             phase: it.phase,
             mis: !last && light.is_none(),
             index: vertex,
+            choice: LightChoice::at(self.light_sampling, &self.lights, it.phase, ray_in.dir),
         };
         let parts = self.direct_light::<S>(&v, draws, c);
         let direct = path.beta * parts.total();
@@ -334,7 +348,7 @@ impl<M: Media> PathTracer<'_, M> {
         if light.is_some() {
             path.beta *= s.weight;
         }
-        path.escape = s.pdf.map_or(Escape::None, Escape::Mis);
+        path.escape = s.pdf.map_or(Escape::None, |pdf| Escape::Mis(pdf, v.choice));
         path.ray = ray_in.spawn(p, s.dir);
         if let Some((index, _)) = region {
             learner.scatter(index, s.dir, s.weight, path.beta, parts.total());

@@ -5,6 +5,7 @@
 
 use glam::Vec3;
 
+use super::light_choice::LightChoice;
 use super::path::PathTracer;
 use super::LightParts;
 use crate::light::LightSample;
@@ -29,48 +30,62 @@ pub(super) struct Vertex<'a> {
     pub mis: bool,
     /// The vertex's index in the draw allocation.
     pub index: u32,
+    /// The probability that each light is sampled here.
+    pub choice: LightChoice,
 }
 
 impl<M: Media> PathTracer<'_, M> {
-    /// NEE at a vertex: the sun and the sky, each one sample.
+    /// NEE at a vertex: one sample of the sun and one of the sky, or of
+    /// one of them picked by `v.choice` (the pick drawn from the hashed
+    /// stream, so the lights' Sobol dimensions stay where they are).
     pub(super) fn direct_light<S: Spectrum>(
         &self,
         v: &Vertex,
         draws: &mut SampleStream,
         c: &mut Counters,
     ) -> LightParts {
+        let (sun_picked, sky_picked) = if v.choice.is_all() {
+            (true, true)
+        } else {
+            let sun = draws.rng().uniform() < v.choice.sun;
+            (sun, !sun)
+        };
         let mut l = LightParts::default();
-        if let Some(sun) = &self.lights.sun {
+        if let Some(sun) = self.lights.sun.as_ref().filter(|_| sun_picked) {
             let (u1, u2) = draws.get_2d(Draw::SunDirection, v.index);
             let s = sun.sample(u1, u2);
             c.nee_rays_sun += 1;
-            l.sun = self.light_term::<S>(v, s, Draw::SunShadow, draws, c);
+            l.sun = self.light_term::<S>(v, s, v.choice.sun, Draw::SunShadow, draws, c);
         }
-        if let Some(env) = &self.lights.environment {
+        if let Some(env) = self.lights.environment.as_ref().filter(|_| sky_picked) {
             let (u1, u2) = draws.get_2d(Draw::SkyDirection, v.index);
             let s = env.sample(u1, u2);
             c.env_samples += 1;
             // A zero-density sample (a pole) is dropped without a shadow ray.
             c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
-            l.sky = self.light_term::<S>(v, s, Draw::SkyShadow, draws, c);
+            l.sky = self.light_term::<S>(v, s, v.choice.sky, Draw::SkyShadow, draws, c);
         }
         l
     }
 
-    /// `f * Li * T * w / p_light` for one light sample; for a delta light
-    /// `radiance` is the irradiance and the pdf is a delta, so `f * E * T`.
+    /// `f * Li * T * w / (pick p_light)` for one light sample, `pick` the
+    /// probability that the vertex sampled this light; for a delta light
+    /// `radiance` is the irradiance and the pdf is a delta, so
+    /// `f * E * T / pick`.
     fn light_term<S: Spectrum>(
         &self,
         v: &Vertex,
         s: LightSample,
+        pick: f32,
         shadow_draw: Draw,
         draws: &mut SampleStream,
         c: &mut Counters,
     ) -> Vec3 {
         let f = v.phase.eval(v.ray_in.dir, s.to_light);
         let weight = match s.pdf {
-            None => f,
+            None => f / pick,
             Some(light_pdf) if light_pdf > 0.0 => {
+                let light_pdf = pick * light_pdf;
                 // Every phase function is sampled exactly: its pdf is f.
                 let w = if v.mis {
                     power_heuristic(light_pdf, f)
