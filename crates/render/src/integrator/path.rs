@@ -34,7 +34,8 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   and a coloured albedo comes for free; Russian roulette does the
 ///   terminating instead.
 /// - Next-event estimation at every scattering event: one sample of the
-///   sun (if any) and one of the environment (if any), each shadow ray's
+///   sun (if any) and one of the environment (if any), or of one of them
+///   picked at random ([`LightSampling`]), each shadow ray's
 ///   transmittance estimated by the chosen estimator. Directions from a
 ///   light sampler and from phase sampling are combined with the power
 ///   heuristic (Veach 1997); a delta sun gets NEE only. At the last

@@ -1,6 +1,6 @@
 //! Next-event estimation for the path tracer: one sample of each light at
-//! a scattering vertex, its shadow ray's transmittance by the chosen
-//! estimator, weighted against the scattered direction's density by the
+//! a scattering vertex, or of one light picked by `light_choice.rs`, its
+//! shadow ray's transmittance by the chosen estimator, weighted against the scattered direction's density by the
 //! power heuristic (Veach 1997).
 
 use glam::Vec3;
