@@ -109,6 +109,10 @@ pub fn voxel_offset(x: i32, y: i32, z: i32) -> usize {
     (((x & 7) as usize) << 6) | (((y & 7) as usize) << 3) | ((z & 7) as usize)
 }
 
+/// Largest brick map a conversion builds: 2^27 bricks (512 MiB of map,
+/// 64 Gi voxels of bounds), far past production clouds.
+pub const MAX_MAP_BRICKS: u64 = 1 << 27;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,7 +130,3 @@ mod tests {
         assert_eq!(BrickRef::decode(3 << 30), BrickRef::Empty);
     }
 }
-
-/// Largest brick map a conversion builds: 2^27 bricks (512 MiB of map,
-/// 64 Gi voxels of bounds), far past production clouds.
-pub const MAX_MAP_BRICKS: u64 = 1 << 27;

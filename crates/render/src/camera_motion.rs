@@ -39,7 +39,11 @@ impl CameraMotion {
                 samples.len()
             )));
         }
-        if samples.windows(2).any(|w| !(w[1].0 > w[0].0)) || !samples[0].0.is_finite() {
+        if samples
+            .windows(2)
+            .any(|w| w[1].0.partial_cmp(&w[0].0) != Some(std::cmp::Ordering::Greater))
+            || !samples[0].0.is_finite()
+        {
             return Err(Error::invalid(
                 "camera pose times must be finite and increasing",
             ));

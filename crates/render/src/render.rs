@@ -508,15 +508,12 @@ fn trained_guide<'m, M: Media>(
         sampler: settings.sampler,
         seed: settings.seed,
     };
-    let (on, mode) = match settings.guiding {
-        GuidingMode::Off => (false, "off".to_string()),
-        GuidingMode::On => (true, "on".to_string()),
-        GuidingMode::Auto => (
-            false,
-            "auto: off (guiding pays on no scene measured yet)".to_string(),
-        ),
+    let decisions = settings.guiding.decisions();
+    let mode = match settings.guiding {
+        GuidingMode::Auto => "auto: off (guiding pays on no scene measured yet)".to_string(),
+        m => m.name().to_string(),
     };
-    if !on {
+    let Some(decisions) = decisions else {
         return (
             None,
             GuidingStats {
@@ -524,13 +521,14 @@ fn trained_guide<'m, M: Media>(
                 ..Default::default()
             },
         );
-    }
+    };
     let spp = match settings.budget {
         Budget::Spp(n) => n,
         Budget::Time(_) => TIMED_TRAINING_SPP,
     };
     let (guide, mut stats, _) = guiding::train(
         media.bounds(),
+        decisions,
         &frame,
         &TrainingSchedule::for_spp(spp),
         |guide, ray, draws, c, recorder| {

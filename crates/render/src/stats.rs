@@ -41,6 +41,10 @@ pub struct Counters {
     /// Times the environment was consulted: directions sampled from it
     /// for next-event estimation, and escaped rays looking it up.
     pub env_samples: u64,
+    /// Path copies made by guided splitting, and paths ended by guided
+    /// roulette (`integrator/path_split.rs`).
+    pub split_copies: u64,
+    pub roulette_ends: u64,
 }
 
 impl AddAssign for Counters {
@@ -59,6 +63,8 @@ impl AddAssign for Counters {
         self.nee_rays_sun += o.nee_rays_sun;
         self.nee_rays_env += o.nee_rays_env;
         self.env_samples += o.env_samples;
+        self.split_copies += o.split_copies;
+        self.roulette_ends += o.roulette_ends;
     }
 }
 

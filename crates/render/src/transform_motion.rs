@@ -32,7 +32,11 @@ impl PoseTable {
     /// `maps[k]` at time `open + k (close - open) / (maps.len() - 1)`; at
     /// least two maps and `close > open`.
     pub fn new(open: f32, close: f32, maps: Vec<Mat4>) -> Result<PoseTable> {
-        if maps.len() < 2 || !(close > open) || !open.is_finite() || !close.is_finite() {
+        if maps.len() < 2
+            || close.partial_cmp(&open) != Some(std::cmp::Ordering::Greater)
+            || !open.is_finite()
+            || !close.is_finite()
+        {
             return Err(Error::invalid(format!(
                 "a pose table needs two or more maps over open < close, got {} over [{open}, {close}]",
                 maps.len()

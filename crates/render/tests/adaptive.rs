@@ -28,14 +28,6 @@ fn adaptive(spp: u32, seed: u64, threshold: f32, min_spp: u32) -> RenderSettings
     s
 }
 
-fn with_threads(threads: usize, f: impl FnOnce() -> Rendered + Send) -> Rendered {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap()
-        .install(f)
-}
-
 fn samples(r: &Rendered) -> &[f32] {
     &r.aovs.as_ref().expect("AOVs kept").samples
 }
@@ -145,15 +137,11 @@ fn samples_go_to_the_cloud_not_the_sky() {
     assert_eq!(out.image.spp, *out.image.samples.iter().max().unwrap());
 }
 
+/// The image's bits with each pixel's sample count.
 fn bits(r: &Rendered) -> Vec<u32> {
-    let i = &r.image;
-    i.rgba
-        .iter()
-        .chain(&i.variance)
-        .flatten()
-        .map(|x| x.to_bits())
-        .chain(i.samples.iter().copied())
-        .collect()
+    let mut b = common::image_bits(r);
+    b.extend(r.image.samples.iter().copied());
+    b
 }
 
 #[test]
@@ -163,8 +151,8 @@ fn adaptive_images_are_identical_on_one_and_two_threads() {
         let mut s = adaptive(128, 42, 0.05, 8);
         s.sampler = sampler;
         s.tile_size = 8;
-        let one = with_threads(1, || render(&scene, &s));
-        let two = with_threads(2, || render(&scene, &s));
+        let one = common::with_threads(1, || render(&scene, &s));
+        let two = common::with_threads(2, || render(&scene, &s));
         assert_eq!(bits(&one), bits(&two), "{sampler:?}");
         assert_eq!(one.aovs, two.aovs, "{sampler:?}");
     }
@@ -186,7 +174,7 @@ fn adaptive_crops_are_bit_identical_to_the_full_render() {
     };
     s.crop = Some(crop);
     s.tile_size = 4;
-    let part = with_threads(2, || render(&scene, &s));
+    let part = common::with_threads(2, || render(&scene, &s));
     let (w, fw) = (part.image.width, full.image.width);
     for y in 0..part.image.height {
         for x in 0..w {

@@ -294,11 +294,9 @@ fn layers_do_not_depend_on_the_thread_count() {
     s.compositing.cryptomatte = true;
     s.compositing.deep_samples = Some(4);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| common::render_through(&volumes(true), &camera(), &lights(true, true), &s))
+        common::with_threads(threads, || {
+            common::render_through(&volumes(true), &camera(), &lights(true, true), &s)
+        })
     };
     let (one, three) = (run(1), run(3));
     assert_eq!(one.image, three.image);

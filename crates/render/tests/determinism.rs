@@ -19,11 +19,7 @@ fn render_with_threads(threads: usize, kind: IntegratorKind, seed: u64) -> Rende
     // Tiles smaller than the image so two workers really share it.
     settings.tile_size = 8;
     settings.step_voxels = 2.0;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| render(&scene, &settings))
+    common::with_threads(threads, || render(&scene, &settings))
 }
 
 #[test]
@@ -35,16 +31,7 @@ fn same_seed_same_image_for_any_thread_count() {
     ] {
         let one = render_with_threads(1, kind, 42);
         let two = render_with_threads(2, kind, 42);
-        // Bitwise: compare the bits, so even -0.0 against 0.0 would fail.
-        let bits = |r: &Rendered| -> Vec<u32> {
-            r.image
-                .rgba
-                .iter()
-                .chain(&r.image.variance)
-                .flatten()
-                .map(|x| x.to_bits())
-                .collect()
-        };
+        let bits = common::image_bits;
         assert_eq!(bits(&one), bits(&two), "{kind:?}: images differ");
         // Work counters are sums of per-tile integers: identical too.
         assert_eq!(

@@ -1,4 +1,6 @@
-//! Guided path tracing stays exact and reproducible:
+//! Guided path tracing stays exact and reproducible, in both guided modes
+//! (`on`: roulette and splitting; `directions`: resampled directions as
+//! well):
 //! - a guided render is the same, bit for bit, on one thread and two, and
 //!   a crop of it is the full render's pixels (training covers the whole
 //!   frame on a fixed schedule);
@@ -10,28 +12,8 @@
 
 mod common;
 
-use cirrus_render::{
-    render, Crop, Extinction, GuidingMode, IntegratorKind, Lights, Medium, Phase, Rendered,
-};
+use cirrus_render::{render, Crop, Extinction, GuidingMode, IntegratorKind, Lights, Medium, Phase};
 use glam::Vec3;
-
-fn with_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap()
-        .install(f)
-}
-
-fn bits(r: &Rendered) -> Vec<u32> {
-    r.image
-        .rgba
-        .iter()
-        .chain(&r.image.variance)
-        .flatten()
-        .map(|x| x.to_bits())
-        .collect()
-}
 
 fn sunlit_cloud(
     scale: f32,
@@ -47,17 +29,36 @@ fn sunlit_cloud(
     )
 }
 
+const GUIDED: [GuidingMode; 2] = [GuidingMode::On, GuidingMode::Directions];
+
 #[test]
 fn guided_renders_are_the_same_on_any_thread_count_and_in_crops() {
-    let scene = sunlit_cloud(20.0);
+    for mode in GUIDED {
+        same_on_any_thread_count_and_in_crops(mode);
+    }
+}
+
+fn same_on_any_thread_count_and_in_crops(mode: GuidingMode) {
+    let scene = sunlit_cloud(60.0);
     let mut s = common::settings(IntegratorKind::Path, 64, 5);
-    s.guiding = GuidingMode::On;
+    s.guiding = mode;
     s.tile_size = 8;
-    let one = with_threads(1, || render(&scene, &s));
-    let two = with_threads(2, || render(&scene, &s));
-    assert_eq!(bits(&one), bits(&two), "guided images differ");
+    let one = common::with_threads(1, || render(&scene, &s));
+    let two = common::with_threads(2, || render(&scene, &s));
+    assert_eq!(
+        common::image_bits(&one),
+        common::image_bits(&two),
+        "{mode:?}: guided images differ"
+    );
     let stats = two.stats.guiding.as_ref().expect("guiding stats");
-    assert_eq!(stats.mode, "on");
+    assert_eq!(stats.mode, mode.name());
+    // The weight window both split and ended paths here.
+    let c = &two.stats.counters;
+    eprintln!(
+        "{mode:?}: {} copies, {} ended",
+        c.split_copies, c.roulette_ends
+    );
+    assert!(c.split_copies > 0 && c.roulette_ends > 0, "{mode:?}: {c:?}");
     assert!(stats.regions > 1, "the cache never split: {stats:?}");
     assert!(stats.memory_bytes > 0 && stats.records > 0, "{stats:?}");
 
@@ -69,7 +70,7 @@ fn guided_renders_are_the_same_on_any_thread_count_and_in_crops() {
     };
     s.crop = Some(crop);
     s.tile_size = 4;
-    let part = with_threads(2, || render(&scene, &s));
+    let part = common::with_threads(2, || render(&scene, &s));
     let (w, fw) = (part.image.width, two.image.width);
     for y in 0..part.image.height {
         for x in 0..w {
@@ -78,7 +79,7 @@ fn guided_renders_are_the_same_on_any_thread_count_and_in_crops() {
             assert_eq!(
                 part.image.rgba[i].map(f32::to_bits),
                 two.image.rgba[j].map(f32::to_bits),
-                "crop pixel ({x}, {y})"
+                "{mode:?}: crop pixel ({x}, {y})"
             );
         }
     }
@@ -91,7 +92,8 @@ fn guided_renders_are_the_same_on_any_thread_count_and_in_crops() {
 /// is a product of resampling weights, heavy-tailed, so a pixel's 64
 /// samples often underestimate its own standard error; the image's sum
 /// over hundreds of pixels is near normal again.
-fn assert_furnace(label: &str, medium: Medium<cirrus_render::GridField>) {
+fn assert_furnace(label: &str, mode: GuidingMode, medium: Medium<cirrus_render::GridField>) {
+    let label = format!("{mode:?} {label}");
     let lights = Lights {
         sun: None,
         environment: common::env(Vec3::ONE),
@@ -101,7 +103,7 @@ fn assert_furnace(label: &str, medium: Medium<cirrus_render::GridField>) {
     // the thick Mie furnace measured z -4.95; at 512, 0.87).
     let mut s = common::settings(IntegratorKind::Path, 512, 11);
     s.max_depth = None;
-    s.guiding = GuidingMode::On;
+    s.guiding = mode;
     let out = render(&scene, &s);
     assert_eq!(out.stats.counters.nonfinite_samples, 0, "{label}");
     assert!(
@@ -133,49 +135,54 @@ fn assert_furnace(label: &str, medium: Medium<cirrus_render::GridField>) {
 #[test]
 fn the_white_furnace_holds_guided() {
     // Peak optical depth about 5 (thin) and 40 (thick).
-    for (thickness, scale) in [("thin", 8.0), ("thick", 64.0)] {
-        let hg = common::medium(common::cloud_field(4), scale, 1.0, 0.8);
-        assert_furnace(&format!("{thickness} HG 0.8"), hg);
-        let mie = common::medium(common::cloud_field(4), scale, 1.0, 0.0)
-            .with_phase(Phase::mie(10.0).unwrap());
-        assert_furnace(&format!("{thickness} Mie 10 um"), mie);
-        let e = Extinction::split(Vec3::new(1.0, 0.6, 0.3) * scale);
-        let chromatic = Medium::new(common::cloud_field(4), e.scale, Vec3::ONE, 0.5)
-            .with_extinction_tint(e.tint);
-        assert_furnace(&format!("{thickness} chromatic"), chromatic);
+    for mode in GUIDED {
+        for (thickness, scale) in [("thin", 8.0), ("thick", 64.0)] {
+            let hg = common::medium(common::cloud_field(4), scale, 1.0, 0.8);
+            assert_furnace(&format!("{thickness} HG 0.8"), mode, hg);
+            let mie = common::medium(common::cloud_field(4), scale, 1.0, 0.0)
+                .with_phase(Phase::mie(10.0).unwrap());
+            assert_furnace(&format!("{thickness} Mie 10 um"), mode, mie);
+            let e = Extinction::split(Vec3::new(1.0, 0.6, 0.3) * scale);
+            let chromatic = Medium::new(common::cloud_field(4), e.scale, Vec3::ONE, 0.5)
+                .with_extinction_tint(e.tint);
+            assert_furnace(&format!("{thickness} chromatic"), mode, chromatic);
+        }
     }
 }
 
 #[test]
 fn guided_and_unguided_renders_agree_under_sun_and_sky() {
-    let scene = sunlit_cloud(20.0);
+    let scene = sunlit_cloud(60.0);
     let mut s = common::settings(IntegratorKind::Path, 64, 21);
     s.max_depth = None;
     s.guiding = GuidingMode::Off;
     let unguided = render(&scene, &s);
-    s.seed = 22;
-    s.guiding = GuidingMode::On;
-    let guided = render(&scene, &s);
-    // The pooled bias only (`common::assert_pooled_agreement`'s chi-square
-    // needs per-pixel standard errors the heavy-tailed guided weights
-    // underestimate; see `assert_furnace`).
-    for c in 0..3 {
-        let d = common::differences(&guided.image, &unguided.image, c);
-        assert!(d.diff.len() > 200, "channel {c}: {} pixels", d.diff.len());
-        let z = d.diff.iter().sum::<f64>() / d.var.iter().sum::<f64>().sqrt();
-        eprintln!("guided vs unguided, channel {c}: pooled z {z:.3}");
-        assert!(z.abs() <= 4.0, "channel {c}: pooled z {z}");
+    for (mode, seed) in GUIDED.into_iter().zip(22..) {
+        s.seed = seed;
+        s.guiding = mode;
+        let guided = render(&scene, &s);
+        assert!(guided.stats.counters.split_copies > 0, "{mode:?}");
+        // The pooled bias only (`common::assert_pooled_agreement`'s chi-square
+        // needs per-pixel standard errors the heavy-tailed guided weights
+        // underestimate; see `assert_furnace`).
+        for c in 0..3 {
+            let d = common::differences(&guided.image, &unguided.image, c);
+            assert!(d.diff.len() > 200, "channel {c}: {} pixels", d.diff.len());
+            let z = d.diff.iter().sum::<f64>() / d.var.iter().sum::<f64>().sqrt();
+            eprintln!("{mode:?} vs unguided, channel {c}: pooled z {z:.3}");
+            assert!(z.abs() <= 4.0, "{mode:?}, channel {c}: pooled z {z}");
+        }
     }
 }
 
 #[test]
 fn auto_renders_what_off_renders() {
-    let scene = sunlit_cloud(20.0);
+    let scene = sunlit_cloud(60.0);
     let mut s = common::settings(IntegratorKind::Path, 8, 3);
     s.guiding = GuidingMode::Off;
     let off = render(&scene, &s);
     s.guiding = GuidingMode::Auto;
     let auto = render(&scene, &s);
-    assert_eq!(bits(&off), bits(&auto));
+    assert_eq!(common::image_bits(&off), common::image_bits(&auto));
     assert!(auto.stats.guiding.unwrap().mode.starts_with("auto: off"));
 }

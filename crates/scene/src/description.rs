@@ -93,8 +93,10 @@ declare_settings! {
     majorant: MajorantMode, flag(long, value_enum), default(MajorantMode::Auto),
         example(MajorantMode::Global);
     /// Path guiding: learn where the light comes from (a radiance cache
-    /// trained on the frame's own paths) and scatter toward it; `auto`
-    /// guides where that pays, which measured is nowhere yet (on: try it).
+    /// trained on the frame's own paths); `on` plays roulette with paths
+    /// headed for the dark and splits those reaching the light,
+    /// `directions` also scatters toward the learned light; `auto` guides
+    /// where that pays, which measured is nowhere yet.
     guiding: GuidingMode, flag(long, value_enum), default(GuidingMode::Auto),
         example(GuidingMode::On);
     /// Next-event estimation at each scattering vertex: a shadow ray to

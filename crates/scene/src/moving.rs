@@ -38,7 +38,7 @@ pub struct Track {
 pub fn track(v: &VolumeSpec, frame: f64, shutter: [f32; 2]) -> Option<Track> {
     let samples = v.transform.samples.as_ref()?;
     let [open, close] = shutter;
-    if !(close > open) {
+    if close.partial_cmp(&open) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let matrices: Vec<DMat4> = (0..TABLE_MAPS)

@@ -139,7 +139,7 @@ fn broken_stages_name_the_prim_and_the_file() {
     );
     assert_eq!(e.kind(), ErrorKind::File);
     for part in ["missing.usda", "/World/Cloud/density", "nowhere.vdb"] {
-        assert!(e.to_string().contains(part), "{part}: {}", e.to_string());
+        assert!(e.to_string().contains(part), "{part}: {}", e);
     }
     let e = err(
         "grid.usda",
@@ -152,7 +152,7 @@ fn broken_stages_name_the_prim_and_the_file() {
         "\"smoke\"",
         "density",
     ] {
-        assert!(e.to_string().contains(part), "{part}: {}", e.to_string());
+        assert!(e.to_string().contains(part), "{part}: {}", e);
     }
     std::fs::write(
         d.join("garbage.usda"),

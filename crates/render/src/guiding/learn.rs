@@ -14,6 +14,7 @@ use smallvec::SmallVec;
 
 use super::regions::Record;
 use super::sphere::bin_of;
+use super::Site;
 
 /// Luminance (Rec. 709): how a colour is weighed for learning.
 #[inline]
@@ -23,12 +24,15 @@ pub fn luminance(c: Vec3) -> f32 {
 
 /// What a path reports as it goes.
 pub trait Learner {
-    /// A scattering vertex in `region` left along `dir`, its throughput
+    /// Whether it learns: a path that teaches the cache is never split
+    /// (its records follow one chain of vertices).
+    const LEARNS: bool;
+    /// A scattering vertex at `site` left along `dir`, its throughput
     /// multiplied by `weight` there (the phase function over the density
     /// the direction was sampled with); `beta` is the throughput after it,
     /// `direct` the light next-event estimation found there (not weighted
     /// by the throughput).
-    fn scatter(&mut self, region: u32, dir: Vec3, weight: f32, beta: Vec3, direct: Vec3);
+    fn scatter(&mut self, site: Site, dir: Vec3, weight: f32, beta: Vec3, direct: Vec3);
     /// The path added `c` (throughput included) to its pixel.
     fn contribute(&mut self, c: Vec3);
     /// The path ended.
@@ -39,8 +43,9 @@ pub trait Learner {
 pub struct Ignore;
 
 impl Learner for Ignore {
+    const LEARNS: bool = false;
     #[inline(always)]
-    fn scatter(&mut self, _: u32, _: Vec3, _: f32, _: Vec3, _: Vec3) {}
+    fn scatter(&mut self, _: Site, _: Vec3, _: f32, _: Vec3, _: Vec3) {}
     #[inline(always)]
     fn contribute(&mut self, _: Vec3) {}
     #[inline(always)]
@@ -53,7 +58,7 @@ const MAX_VERTICES: usize = 64;
 
 #[derive(Clone, Copy)]
 struct Vertex {
-    region: u32,
+    site: Site,
     bin: u16,
     weight: f32,
     beta: f32,
@@ -80,10 +85,11 @@ impl<'a> PathRecorder<'a> {
 }
 
 impl Learner for PathRecorder<'_> {
-    fn scatter(&mut self, region: u32, dir: Vec3, weight: f32, beta: Vec3, direct: Vec3) {
+    const LEARNS: bool = true;
+    fn scatter(&mut self, site: Site, dir: Vec3, weight: f32, beta: Vec3, direct: Vec3) {
         if self.vertices.len() < MAX_VERTICES {
             self.vertices.push(Vertex {
-                region,
+                site,
                 bin: bin_of(dir) as u16,
                 weight,
                 beta: luminance(beta),
@@ -104,7 +110,8 @@ impl Learner for PathRecorder<'_> {
             }
             let incident = ((self.total - v.total_at) / v.beta).max(0.0);
             self.out.push(Record {
-                region: v.region,
+                region: v.site.region,
+                cell: v.site.cell,
                 bin: v.bin,
                 incident,
                 inscattered: v.weight * incident + v.direct,

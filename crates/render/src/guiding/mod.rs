@@ -11,24 +11,35 @@
 //! - `training`: the fixed schedule of training passes over the whole
 //!   frame ([`train`]).
 //!
-//! A [`Guide`] is the cache frozen for a pass. The path tracer samples a
-//! scattering direction in proportion to the product of the phase
-//! function and the learned incident radiance, the zero-variance choice
-//! of Herholz et al. 2019 ("Volume Path Guiding Based on Zero-Variance
-//! Random Walk Theory", section 4), by resampled importance sampling
-//! ([`resample`]): a mixture of the phase function and the learned light
-//! alone compounds a weight of up to `1 / (1 - a)` per vertex where the
-//! phase function is forward peaked (g 0.8) and paths scatter hundreds of
-//! times, which measured worse than no guiding.
+//! - `grid`: the in-scattered radiance on a pyramid of regular grids,
+//!   finer than the regions, for roulette and splitting.
+//!
+//! A [`Guide`] is the cache frozen for a pass. It guides two decisions
+//! ([`Decisions`]), each unbiased for any cache:
+//! - roulette and splitting (`integrator/path_split.rs`, Vorba and
+//!   Křivánek 2016): a path whose expected contribution, its throughput
+//!   times the learned in-scattered radiance, falls far below what it was
+//!   expected to bring at its first vertex plays roulette, one far above
+//!   splits;
+//! - directions (`integrator/path_scatter.rs`): a one-sample mixture of
+//!   the phase function and the product of the phase function with the
+//!   learned incident light (Herholz et al. 2019, "Volume Path Guiding
+//!   Based on Zero-Variance Random Walk Theory", section 4), its density
+//!   exact.
+//!
+//! Measured on a thick, bright cloud (BENCHMARKS.md, "Guided path
+//! tracing") neither pays yet at equal time, so `auto` renders unguided.
 
+mod grid;
 mod learn;
 mod regions;
 mod sphere;
 mod training;
 
+pub use grid::InscatteredGrid;
 pub use learn::{luminance, Ignore, Learner, PathRecorder};
 pub use regions::{Record, Region, Regions, MAX_REGIONS};
-pub use sphere::{IncidentLight, BINS};
+pub use sphere::{bin_centres, BinDistribution, IncidentLight, BINS};
 pub use training::{train, Frame, TrainingSchedule};
 
 use glam::Vec3;
@@ -36,11 +47,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::medium::Bounds3;
 
-/// Candidate directions drawn from the phase function for each guided
-/// direction.
-pub const CANDIDATES: usize = 8;
-
-/// Whether the path tracer learns and follows a radiance cache.
+/// Whether the path tracer learns and follows a radiance cache, and which
+/// decisions it guides ([`Decisions`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
@@ -51,7 +59,11 @@ pub enum GuidingMode {
     /// renders unguided: the same image, bit for bit, as `off`.
     #[default]
     Auto,
+    /// Roulette and splitting against the learned in-scattered light.
     On,
+    /// As `on`, and scattered directions resampled toward the learned
+    /// incident light.
+    Directions,
     Off,
 }
 
@@ -60,60 +72,118 @@ impl GuidingMode {
         match self {
             Self::Auto => "auto",
             Self::On => "on",
+            Self::Directions => "directions",
             Self::Off => "off",
         }
     }
+
+    /// The decisions a guide makes in this mode (`auto` as it resolves),
+    /// `None` for unguided rendering.
+    pub fn decisions(self) -> Option<Decisions> {
+        match self {
+            Self::Auto | Self::Off => None,
+            Self::On => Some(Decisions {
+                directions: false,
+                roulette: true,
+            }),
+            Self::Directions => Some(Decisions {
+                directions: true,
+                roulette: true,
+            }),
+        }
+    }
+}
+
+/// Where a path vertex lies in the cache: its region and its grid cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Site {
+    pub region: u32,
+    pub cell: u32,
+}
+
+/// Which sampling decisions a guide makes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Decisions {
+    /// Scattered directions resampled toward the learned incident light.
+    pub directions: bool,
+    /// Russian roulette and splitting against the learned in-scattered
+    /// radiance (Vorba and Křivánek 2016).
+    pub roulette: bool,
 }
 
 /// The radiance cache, frozen: what a pass's paths are guided by.
 #[derive(Clone, Debug)]
 pub struct Guide {
     regions: Regions,
+    grid: InscatteredGrid,
+    decisions: Decisions,
 }
 
 impl Guide {
-    /// An empty cache over `bounds` (it guides nothing until it learns).
-    pub fn new(bounds: Bounds3) -> Guide {
+    /// An empty cache over `bounds` (it guides nothing until it learns)
+    /// making `decisions`.
+    pub fn new(bounds: Bounds3, decisions: Decisions) -> Guide {
         Guide {
             regions: Regions::new(bounds),
+            grid: InscatteredGrid::new(bounds),
+            decisions,
         }
     }
 
-    /// The region at `p`.
+    /// Where `p` lies in the cache.
     #[inline]
-    pub fn region_at(&self, p: Vec3) -> (u32, &Region) {
-        let i = self.regions.index_of(p);
-        (i, self.regions.region(i))
+    pub fn site_of(&self, p: Vec3) -> Site {
+        Site {
+            region: self.regions.index_of(p),
+            cell: self.grid.cell_of(p),
+        }
+    }
+
+    /// The learned incident light that guides directions at `site`, if
+    /// the guide guides directions and has learned there.
+    #[inline]
+    pub fn light(&self, site: Site) -> Option<&IncidentLight> {
+        if !self.decisions.directions {
+            return None;
+        }
+        self.regions.region(site.region).light()
+    }
+
+    /// The learned in-scattered radiance (luminance) at `site`, for
+    /// roulette and splitting: the cell's mean where it has learned
+    /// enough, else its region's; `None` where the guide does not do
+    /// roulette or nothing was learned.
+    #[inline]
+    pub fn inscattered(&self, site: Site) -> Option<f32> {
+        if !self.decisions.roulette {
+            return None;
+        }
+        let l = self
+            .grid
+            .mean(site.cell)
+            .unwrap_or_else(|| self.regions.region(site.region).inscattered());
+        (l > 0.0).then_some(l)
+    }
+
+    pub fn decisions(&self) -> Decisions {
+        self.decisions
+    }
+
+    /// Learns records made with this guide's tree and grid.
+    pub(crate) fn accumulate(&mut self, records: Vec<Record>) {
+        for r in &records {
+            self.grid.add(r.cell, r.inscattered);
+        }
+        self.regions.accumulate(records);
+    }
+
+    pub fn memory_bytes(&self) -> usize {
+        self.regions.memory_bytes() + self.grid.memory_bytes()
     }
 
     pub fn regions(&self) -> &Regions {
         &self.regions
     }
-}
-
-/// Resampled importance sampling (Talbot, Cline, Egbert 2005) of the
-/// product `phase * L`, `L` the learned incident light: of [`CANDIDATES`]
-/// directions drawn from the phase function, one is kept with probability
-/// proportional to `L` there, `u` choosing it. Returns its index with the
-/// factor its path's throughput takes, `mean(L_k) / L(kept)`: the phase
-/// weight of a phase-sampled direction (1) times the RIS weight, so the
-/// estimate stays unbiased for any learned `L` that is positive everywhere
-/// (`IncidentLight` keeps a floor). The kept direction has no closed-form
-/// density: a guided vertex takes its lights at infinity by next-event
-/// estimation alone.
-pub fn resample(light: &IncidentLight, dirs: &[Vec3; CANDIDATES], u: f32) -> (usize, f32) {
-    let weights = dirs.map(|d| light.radiance(d));
-    let sum: f32 = weights.iter().sum();
-    let mut x = u * sum;
-    let mut kept = CANDIDATES - 1;
-    for (k, &w) in weights.iter().enumerate() {
-        if x < w {
-            kept = k;
-            break;
-        }
-        x -= w;
-    }
-    (kept, (sum / CANDIDATES as f32) / weights[kept])
 }
 
 /// The learned-stats of a render that followed a guide.
@@ -129,71 +199,4 @@ pub struct GuidingStats {
     pub memory_bytes: usize,
     /// Records the cache learned from.
     pub records: u64,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::sphere::tests_direction;
-    use super::*;
-    use crate::phase::Phase;
-    use crate::sampling::Rng;
-
-    /// A learned light brighter over the upper hemisphere, as under a sun.
-    fn learned() -> IncidentLight {
-        let (mut sums, counts) = ([0.0f32; BINS], [8u32; BINS]);
-        for (b, s) in sums.iter_mut().enumerate() {
-            let z = tests_direction(b).z;
-            *s = 8.0 * (0.2 + 3.0 * z.max(0.0));
-        }
-        IncidentLight::new(&sums, &counts).unwrap()
-    }
-
-    /// Mean and standard error of `n` samples of `f`.
-    fn mean_se(n: usize, mut f: impl FnMut() -> f64) -> (f64, f64) {
-        let (mut s, mut s2) = (0.0, 0.0);
-        for _ in 0..n {
-            let x = f();
-            s += x;
-            s2 += x * x;
-        }
-        let m = s / n as f64;
-        (m, ((s2 / n as f64 - m * m) / (n as f64 - 1.0)).sqrt())
-    }
-
-    /// The resampled direction's weight times an integrand estimates the
-    /// integrand's phase-weighted integral, as phase sampling does; the
-    /// same check with the guided density off by 10% (the weight of the
-    /// directions the guide favours scaled by 1.1) fails it.
-    #[test]
-    fn resampling_estimates_the_phase_integral_and_a_broken_density_does_not() {
-        let phase = Phase::hg(0.6);
-        let light = learned();
-        let dir_in = Vec3::new(0.3, 0.2, -0.93).normalize();
-        // An integrand the guide only roughly follows.
-        let f = |d: Vec3| f64::from((d.z + 0.3).max(0.0).powi(2) + 0.05 * (d.x + 1.0));
-        let n = 200_000;
-        let mut rng = Rng::new(3, 0, 0);
-        let (reference, se_ref) = mean_se(n, || {
-            f(phase.sample(dir_in, rng.uniform(), rng.uniform()).0)
-        });
-        let guided = |broken: bool| {
-            let mut rng = Rng::new(4, 0, 0);
-            mean_se(n, || {
-                let dirs: [Vec3; CANDIDATES] =
-                    std::array::from_fn(|_| phase.sample(dir_in, rng.uniform(), rng.uniform()).0);
-                let (k, mut w) = resample(&light, &dirs, rng.uniform());
-                if broken && dirs[k].z > 0.0 {
-                    w *= 1.1;
-                }
-                f64::from(w) * f(dirs[k])
-            })
-        };
-        let z = |(m, se): (f64, f64)| (m - reference) / (se * se + se_ref * se_ref).sqrt();
-        let (exact, broken) = (z(guided(false)), z(guided(true)));
-        assert!(exact.abs() <= 4.0, "resampled estimate off: z {exact}");
-        assert!(
-            broken.abs() > 10.0,
-            "a 10% density error went unseen: z {broken}"
-        );
-    }
 }

@@ -24,6 +24,8 @@ pub const MIN_RECORDS: u32 = 128;
 pub struct Record {
     /// The leaf the vertex lies in (valid for the tree it was made with).
     pub region: u32,
+    /// The vertex's cell in the in-scattered grid.
+    pub cell: u32,
     /// The bin of the direction the path left along.
     pub bin: u16,
     /// An estimate of the radiance that arrived along that direction
@@ -261,6 +263,7 @@ mod tests {
                 );
                 records.push(Record {
                     region: tree.index_of(p),
+                    cell: 0,
                     bin: (k % 7) as u16,
                     incident: if k % 7 == 3 { 5.0 } else { 1.0 },
                     inscattered: 2.0,
@@ -274,7 +277,7 @@ mod tests {
         assert!(corner.bounds.size().max_element() < 4.0);
         assert!((corner.inscattered() - 2.0).abs() < 1e-5);
         let light = corner.light().expect("learned");
-        let bin3 = crate::guiding::sphere::tests_direction(3);
+        let bin3 = crate::guiding::sphere::bin_centre(3);
         assert!(light.radiance(bin3) > light.radiance(-bin3));
         for k in 0..500 {
             let p = Vec3::new(

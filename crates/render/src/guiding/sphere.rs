@@ -41,6 +41,16 @@ pub struct IncidentLight {
     radiance: [f32; BINS],
 }
 
+/// A density over directions, constant within each bin: a bin is drawn in
+/// proportion to its weight, then a point uniform in its solid angle.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BinDistribution {
+    weights: [f32; BINS],
+    /// Running sums of `weights` (the last is the total), searched by
+    /// bisection.
+    cdf: [f32; BINS],
+}
+
 /// A bin's own mean counts once it has this many samples.
 const MIN_BIN_SAMPLES: u32 = 4;
 /// No bin is taken as darker than this share of the mean.
@@ -65,16 +75,80 @@ impl IncidentLight {
         Some(IncidentLight { radiance })
     }
 
+    /// The learned light times `f` (the phase function toward each bin's
+    /// centre), as a density to sample: the product of Herholz et al.
+    /// 2019, section 4, constant over each bin. `None` if the product
+    /// vanishes.
+    pub fn product(&self, f: impl Fn(Vec3) -> f32) -> Option<BinDistribution> {
+        let centres = bin_centres();
+        BinDistribution::new(std::array::from_fn(|b| self.radiance[b] * f(centres[b])))
+    }
+
+    /// The learned radiance of each bin.
+    #[inline]
+    pub fn bins(&self) -> &[f32; BINS] {
+        &self.radiance
+    }
+
     /// The learned radiance arriving from `dir` (positive).
     #[inline]
     pub fn radiance(&self, dir: Vec3) -> f32 {
         self.radiance[bin_of(dir)]
     }
+
+    /// The learned light alone as a density to sample.
+    pub fn distribution(&self) -> BinDistribution {
+        BinDistribution::new(self.radiance).expect("learned light is positive")
+    }
 }
 
-/// A direction at the centre of bin `bin` (for tests).
-#[cfg(test)]
-pub(crate) fn tests_direction(bin: usize) -> Vec3 {
+impl BinDistribution {
+    /// From each bin's weight (finite, non-negative); `None` if all vanish.
+    pub fn new(weights: [f32; BINS]) -> Option<BinDistribution> {
+        let mut cdf = weights;
+        for b in 1..BINS {
+            cdf[b] += cdf[b - 1];
+        }
+        let total = cdf[BINS - 1];
+        (total > 0.0 && total.is_finite()).then_some(BinDistribution { weights, cdf })
+    }
+
+    /// The density (per steradian) of [`BinDistribution::sample`] at
+    /// `dir`: its bin's share of the weight over the bin's solid angle.
+    #[inline]
+    pub fn pdf(&self, dir: Vec3) -> f32 {
+        self.weights[bin_of(dir)] / self.cdf[BINS - 1] * (BINS as f32 / (4.0 * PI))
+    }
+
+    /// A direction drawn from the density: a bin by its share (`u1`,
+    /// reused within the bin for the azimuth), then a point uniform in the
+    /// bin's solid angle (`u2` for `z`). Returns it with its density.
+    pub fn sample(&self, u1: f32, u2: f32) -> (Vec3, f32) {
+        let total = self.cdf[BINS - 1];
+        let x = u1 * total;
+        let bin = self.cdf.partition_point(|&c| c <= x).min(BINS - 1);
+        // Skip empty bins the search may land on at their edge.
+        let bin = (bin..BINS).find(|&b| self.weights[b] > 0.0).unwrap_or(bin);
+        let below = if bin == 0 { 0.0 } else { self.cdf[bin - 1] };
+        // Where `x` fell inside the bin's interval, reused for the azimuth.
+        let v = ((x - below) / self.weights[bin]).clamp(0.0, 1.0 - f32::EPSILON);
+        let (iz, ip) = (bin / PHI_BINS, bin % PHI_BINS);
+        let z = -1.0 + 2.0 * (iz as f32 + u2) / Z_BINS as f32;
+        let phi = 2.0 * PI * (ip as f32 + v) / PHI_BINS as f32;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+        (dir, self.weights[bin] / total * (BINS as f32 / (4.0 * PI)))
+    }
+}
+
+/// The direction at the centre of each bin.
+pub fn bin_centres() -> &'static [Vec3; BINS] {
+    static CENTRES: std::sync::OnceLock<[Vec3; BINS]> = std::sync::OnceLock::new();
+    CENTRES.get_or_init(|| std::array::from_fn(bin_centre))
+}
+
+/// The direction at the centre of bin `bin`.
+pub(crate) fn bin_centre(bin: usize) -> Vec3 {
     let (iz, ip) = (bin / PHI_BINS, bin % PHI_BINS);
     let z = -1.0 + 2.0 * (iz as f32 + 0.5) / Z_BINS as f32;
     let phi = 2.0 * PI * (ip as f32 + 0.5) / PHI_BINS as f32;
@@ -117,12 +191,55 @@ mod tests {
         sums[7] = 100.0;
         let light = IncidentLight::new(&sums, &counts).unwrap();
         let mean = 180.0 / 20.0;
-        let dir = tests_direction;
+        let dir = bin_centre;
         assert_eq!(light.radiance(dir(5)), 10.0);
         assert_eq!(light.radiance(dir(6)), FLOOR * mean);
         // Too few samples: the mean stands in.
         assert_eq!(light.radiance(dir(7)), mean);
         assert_eq!(light.radiance(dir(100)), mean);
         assert!(IncidentLight::new(&[0.0; BINS], &counts).is_none());
+    }
+
+    /// Sampled directions fall in each bin in proportion to its radiance,
+    /// land in the bin they were drawn from, carry the density `pdf`
+    /// gives, and that density integrates to 1 over the sphere.
+    #[test]
+    fn learned_light_samples_its_own_density() {
+        let (mut sums, counts) = ([0.0f32; BINS], [4u32; BINS]);
+        for (b, s) in sums.iter_mut().enumerate() {
+            *s = 4.0 * (1.0 + (b % 7) as f32 + 10.0 * f32::from(b == 40));
+        }
+        let learned = IncidentLight::new(&sums, &counts).unwrap();
+        let total: f32 = (0..BINS).map(|b| learned.radiance(bin_centre(b))).sum();
+        let light = learned.distribution();
+        let mut rng = Rng::new(2, 0, 0);
+        let n = 200_000;
+        let mut hits = [0u32; BINS];
+        for _ in 0..n {
+            let (d, pdf) = light.sample(rng.uniform(), rng.uniform());
+            assert!((d.length() - 1.0).abs() < 1e-4);
+            assert!(
+                (pdf - light.pdf(d)).abs() <= 1e-4 * pdf,
+                "{pdf} against {}",
+                light.pdf(d)
+            );
+            hits[bin_of(d)] += 1;
+        }
+        for (b, &hit) in hits.iter().enumerate() {
+            let expected = f64::from(n) * f64::from(learned.radiance(bin_centre(b)) / total);
+            let c = f64::from(hit);
+            assert!(
+                (c - expected).abs() < 5.0 * expected.sqrt() + 1.0,
+                "bin {b}: {c} against {expected}"
+            );
+        }
+        // Monte Carlo integral of the density over uniform directions.
+        let integral: f64 = (0..n)
+            .map(|_| f64::from(light.pdf(uniform_sphere(rng.uniform(), rng.uniform()))))
+            .sum::<f64>()
+            * 4.0
+            * std::f64::consts::PI
+            / f64::from(n);
+        assert!((integral - 1.0).abs() < 0.01, "{integral}");
     }
 }

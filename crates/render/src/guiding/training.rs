@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use super::learn::PathRecorder;
 use super::regions::Record;
-use super::{Guide, GuidingStats};
+use super::{Decisions, Guide, GuidingStats};
 use crate::camera::Camera;
 use crate::medium::Bounds3;
 use crate::ray::Ray;
@@ -72,6 +72,7 @@ pub struct Frame<'a> {
 /// `guide` (empty in the first pass) and records its path.
 pub fn train<F>(
     bounds: Bounds3,
+    decisions: Decisions,
     frame: &Frame,
     schedule: &TrainingSchedule,
     trace: F,
@@ -80,7 +81,7 @@ where
     F: Fn(&Guide, Ray, &mut SampleStream, &mut Counters, &mut PathRecorder) + Sync,
 {
     let start = Instant::now();
-    let mut guide = Guide::new(bounds);
+    let mut guide = Guide::new(bounds, decisions);
     let mut counters = Counters::default();
     let (w, h) = (frame.camera.width(), frame.camera.height());
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
@@ -114,7 +115,7 @@ where
             for (out, c) in learned {
                 records += out.len() as u64;
                 counters += c;
-                guide.regions.accumulate(out);
+                guide.accumulate(out);
             }
         }
         guide.regions.finish_pass();
@@ -126,7 +127,7 @@ where
         training_spp: schedule.total_spp(),
         training_seconds: start.elapsed().as_secs_f64(),
         regions: guide.regions.len(),
-        memory_bytes: guide.regions.memory_bytes(),
+        memory_bytes: guide.memory_bytes(),
         records,
     };
     (guide, stats, counters)

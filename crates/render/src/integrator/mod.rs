@@ -13,6 +13,7 @@ mod march;
 mod path;
 mod path_light;
 mod path_scatter;
+mod path_split;
 mod raymarch;
 mod raymarch2pass;
 

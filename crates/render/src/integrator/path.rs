@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::light_choice::{LightChoice, LightSampling};
 use super::path_light::Vertex;
+use super::path_split::{At, Pending};
 use super::{escaped_radiance, AovSample, CameraSampler, LightParts, Sample};
 use crate::compositing::{tag, GroupRadiance, LightGroup};
 use crate::guiding::{Guide, Ignore, Learner};
@@ -61,10 +62,12 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   directions, shadow rays' first optical depths, phase direction and
 ///   roulette as the [`Draw`]s of [`crate::sampling`]'s allocation
 ///   (Sobol points for the first vertices); the rest from the hashed stream.
-/// - Guiding: with a [`Guide`], each scattered direction is drawn from
-///   the mixture of the learned incident light and the phase function
-///   (`path_scatter.rs`); NEE's MIS weights and escaped light's take the
-///   mixture's density. Without one, the phase function alone, as always.
+/// - Guiding: with a [`Guide`], each scattering vertex may play roulette
+///   or split against the learned in-scattered light (`path_split.rs`;
+///   render passes only, a training path is one chain), and its direction
+///   may be drawn from the mixture of the phase function and the learned
+///   product (`path_scatter.rs`), whose density NEE's MIS weights and
+///   escaped light's take. Without one, the phase function alone.
 /// - Emission: at every real collision, with the instance chosen with
 ///   probability `sigma_t,i / sigma_t` ([`Media::interaction`]), the
 ///   path adds `beta * (1 - albedo_i) * Le_i`. Delta tracking samples the
@@ -167,24 +170,26 @@ enum Escape {
     /// heuristic): a phase-sampled ray, with the density it had and the
     /// lights' pick probabilities at its vertex.
     Mis(f32, LightChoice),
-    /// Nothing: its vertex took them by next-event estimation alone (a
-    /// resampled direction, or the last allowed vertex).
-    None,
 }
 
 /// A camera path as it is traced: what it carries and what it has found.
-struct Path {
+#[derive(Clone)]
+pub(super) struct Path {
     ray: Ray,
-    beta: Vec3,
+    pub(super) beta: Vec3,
     /// Scattering events so far.
-    depth: u32,
+    pub(super) depth: u32,
     /// How the lights at infinity the current ray escapes to count.
     escape: Escape,
     /// Set after the last allowed scattering event when the media emit:
     /// the path goes on only to find emitted light, lights at infinity
     /// having had their full weight from next-event estimation.
     emission_only: bool,
-    out: Sample,
+    /// What the path is expected to bring, learned at its first
+    /// scattering vertex: the centre of its roulette and splitting weight
+    /// window (0 until then, or where nothing was learned).
+    pub(super) expected: f32,
+    pub(super) out: Sample,
 }
 
 impl Path {
@@ -225,6 +230,7 @@ impl<M: Media> PathTracer<'_, M> {
             depth: 0,
             escape: Escape::Full,
             emission_only: false,
+            expected: 0.0,
             out: Sample {
                 radiance: Vec3::ZERO,
                 alpha: 0.0,
@@ -232,34 +238,88 @@ impl<M: Media> PathTracer<'_, M> {
                 groups: GroupRadiance::default(),
             },
         };
-        loop {
-            // This free flight and the events at its collision are path
-            // vertex `vertex` of the draw allocation.
-            let vertex = path.depth;
-            let ray = path.ray;
-            let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
-                sample_free_flight::<S, M>(self.medium, &ray, ray.t_max, &mut path.beta, rng, c)
-            });
-            if path.depth == 0 {
-                path.out.alpha = match flight {
-                    FreeFlight::Escaped => S::escaped_alpha(path.beta),
-                    _ => 1.0,
-                };
-            }
-            let t = match flight {
-                FreeFlight::Escaped => {
-                    self.escape(&mut path, c, learner);
-                    break;
-                }
-                FreeFlight::Capped => break,
-                FreeFlight::Collision { t } => t,
-            };
-            if !self.collide::<S>(&mut path, guide, t, vertex, draws, c, learner) {
-                break;
-            }
+        let mut pending = Pending::default();
+        self.walk::<S, _>(&mut path, guide, None, draws, c, learner, &mut pending);
+        // The copies a split left, each with its own numbers.
+        while let Some(branch) = pending.pop() {
+            let out = std::mem::take(&mut path.out);
+            path = branch.path;
+            path.out = out;
+            let mut stream = branch.stream;
+            self.walk::<S, _>(
+                &mut path,
+                guide,
+                Some(branch.at),
+                &mut stream,
+                c,
+                learner,
+                &mut pending,
+            );
         }
         learner.finish();
         path.out
+    }
+
+    /// Follows one branch of a path until it ends: from its camera ray,
+    /// or from scattering vertex `start` a split left it at. The copies it
+    /// splits into go to `pending`.
+    #[allow(clippy::too_many_arguments)]
+    fn walk<'m, S: Spectrum, L: Learner>(
+        &'m self,
+        path: &mut Path,
+        guide: Option<&Guide>,
+        mut start: Option<At<'m>>,
+        draws: &mut SampleStream,
+        c: &mut Counters,
+        learner: &mut L,
+        pending: &mut Pending<'m>,
+    ) {
+        loop {
+            let at = match start.take() {
+                Some(at) => at,
+                None => {
+                    // This free flight and the events at its collision are
+                    // path vertex `path.depth` of the draw allocation.
+                    let vertex = path.depth;
+                    let ray = path.ray;
+                    let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
+                        sample_free_flight::<S, M>(
+                            self.medium,
+                            &ray,
+                            ray.t_max,
+                            &mut path.beta,
+                            rng,
+                            c,
+                        )
+                    });
+                    if path.depth == 0 {
+                        path.out.alpha = match flight {
+                            FreeFlight::Escaped => S::escaped_alpha(path.beta),
+                            _ => 1.0,
+                        };
+                    }
+                    let t = match flight {
+                        FreeFlight::Escaped => return self.escape(path, c, learner),
+                        FreeFlight::Capped => return,
+                        FreeFlight::Collision { t } => t,
+                    };
+                    match self.collide::<S>(path, t, vertex, draws, c, learner) {
+                        Some(at) => at,
+                        None => return,
+                    }
+                }
+            };
+            if !L::LEARNS {
+                let copies = self.weight_window(path, guide, &at, pending, draws, c);
+                pending.split(path, &at, copies, draws);
+                if copies == 0 {
+                    return;
+                }
+            }
+            if !self.scatter_from::<S>(path, guide, &at, draws, c, learner) {
+                return;
+            }
+        }
     }
 
     /// The path left the media: the lights at infinity it reaches.
@@ -268,7 +328,6 @@ impl<M: Media> PathTracer<'_, M> {
         // held-out geometry, the sky included, never shows.
         let pdf = match path.escape {
             _ if path.emission_only || path.ray.t_max.is_finite() => return,
-            Escape::None => return,
             Escape::Full => None,
             Escape::Mis(pdf, choice) => Some((pdf, choice)),
         };
@@ -280,20 +339,18 @@ impl<M: Media> PathTracer<'_, M> {
         }
     }
 
-    /// The events at a real collision at `t`: emission, next-event
-    /// estimation and the scattered direction. Returns false when the path
-    /// ends there.
-    #[allow(clippy::too_many_arguments)]
-    fn collide<S: Spectrum>(
-        &self,
+    /// The events at a real collision at `t` up to scattering: the
+    /// interaction, emission and the albedo. Returns the scattering vertex,
+    /// or `None` when the path ends there.
+    fn collide<'m, S: Spectrum>(
+        &'m self,
         path: &mut Path,
-        guide: Option<&Guide>,
         t: f32,
         vertex: u32,
         draws: &mut SampleStream,
         c: &mut Counters,
         learner: &mut impl Learner,
-    ) -> bool {
+    ) -> Option<At<'m>> {
         let p = path.ray.at(t);
         let it = self.medium.interaction(p, path.ray.time, draws.rng());
         if S::CHROMATIC {
@@ -303,7 +360,7 @@ impl<M: Media> PathTracer<'_, M> {
             // A holdout volume seen first is a matte: no light, no alpha.
             if it.holdout {
                 path.out.alpha = 0.0;
-                return false;
+                return None;
             }
             let aov = &mut path.out.aov;
             aov.albedo = it.albedo;
@@ -314,24 +371,50 @@ impl<M: Media> PathTracer<'_, M> {
             self.emit(path, p, &it, c, learner);
         }
         if self.max_depth == Some(path.depth) {
-            return false;
+            return None;
         }
         path.depth += 1;
         path.beta *= it.albedo;
         if path.beta.max_element() <= 0.0 {
-            return false;
+            return None;
         }
+        Some(At {
+            p,
+            phase: it.phase,
+            vertex,
+        })
+    }
+
+    /// The events at scattering vertex `at`: next-event estimation, the
+    /// scattered direction and roulette. Returns false when the path ends
+    /// there.
+    fn scatter_from<S: Spectrum>(
+        &self,
+        path: &mut Path,
+        guide: Option<&Guide>,
+        at: &At,
+        draws: &mut SampleStream,
+        c: &mut Counters,
+        learner: &mut impl Learner,
+    ) -> bool {
+        let (p, vertex) = (at.p, at.vertex);
         let last = self.max_depth == Some(path.depth);
-        let region = guide.map(|g| g.region_at(p));
-        let light = region.and_then(|(_, r)| r.light());
+        let site = guide.map(|g| (g, g.site_of(p)));
         let ray_in = path.ray;
+        // A guided vertex draws from the product of its learned light and
+        // its phase function (built once: NEE weighs against it too).
+        let product = site
+            .and_then(|(g, site)| g.light(site))
+            .and_then(|l| l.product(|d| at.phase.eval(ray_in.dir, d)));
+        let light = product.as_ref();
         let v = Vertex {
             p,
             ray_in: &ray_in,
-            phase: it.phase,
-            mis: !last && light.is_none(),
+            phase: at.phase,
+            mis: !last,
+            guide: light,
             index: vertex,
-            choice: LightChoice::at(self.light_sampling, &self.lights, it.phase, ray_in.dir),
+            choice: LightChoice::at(self.light_sampling, &self.lights, at.phase, ray_in.dir),
         };
         let parts = self.direct_light::<S>(&v, draws, c);
         let direct = path.beta * parts.total();
@@ -345,14 +428,14 @@ impl<M: Media> PathTracer<'_, M> {
             }
             path.emission_only = true;
         }
-        let s = self.scatter(&ray_in, it.phase, light, vertex, draws);
+        let s = self.scatter(&ray_in, at.phase, light, vertex, draws);
         if light.is_some() {
             path.beta *= s.weight;
         }
-        path.escape = s.pdf.map_or(Escape::None, |pdf| Escape::Mis(pdf, v.choice));
+        path.escape = Escape::Mis(s.pdf, v.choice);
         path.ray = ray_in.spawn(p, s.dir);
-        if let Some((index, _)) = region {
-            learner.scatter(index, s.dir, s.weight, path.beta, parts.total());
+        if let Some((_, site)) = site {
+            learner.scatter(site, s.dir, s.weight, path.beta, parts.total());
         }
         self.roulette(path, vertex, draws)
     }

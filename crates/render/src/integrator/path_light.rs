@@ -7,7 +7,9 @@ use glam::Vec3;
 
 use super::light_choice::LightChoice;
 use super::path::PathTracer;
+use super::path_scatter::mixture_pdf;
 use super::LightParts;
+use crate::guiding::BinDistribution;
 use crate::light::LightSample;
 use crate::medium::Media;
 use crate::phase::Phase;
@@ -24,10 +26,11 @@ pub(super) struct Vertex<'a> {
     pub ray_in: &'a Ray,
     pub phase: &'a Phase,
     /// Weight against the scattered direction (false at the last allowed
-    /// vertex, whose continuation cannot reach a light, and at a guided
-    /// one, whose resampled direction has no density to weigh by: its
-    /// escapes take no light at infinity).
+    /// vertex, whose continuation cannot reach a light).
     pub mis: bool,
+    /// The learned light a guided vertex's direction is partly drawn
+    /// from: the scattered direction's density is then the mixture's.
+    pub guide: Option<&'a BinDistribution>,
     /// The vertex's index in the draw allocation.
     pub index: u32,
     /// The probability that each light is sampled here.
@@ -88,7 +91,8 @@ impl<M: Media> PathTracer<'_, M> {
                 let light_pdf = pick * light_pdf;
                 // Every phase function is sampled exactly: its pdf is f.
                 let w = if v.mis {
-                    power_heuristic(light_pdf, f)
+                    let scatter_pdf = v.guide.map_or(f, |g| mixture_pdf(f, g.pdf(s.to_light)));
+                    power_heuristic(light_pdf, scatter_pdf)
                 } else {
                     1.0
                 };

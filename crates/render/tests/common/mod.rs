@@ -161,3 +161,24 @@ pub fn assert_pooled_agreement(label: &str, d: &Differences) {
         d.exact_diff
     );
 }
+
+/// Runs `f` on a pool of `threads` workers.
+pub fn with_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+/// The bits of a render's pixels and their variances: equal bits, equal
+/// images (even -0.0 against 0.0 differs).
+pub fn image_bits(r: &Rendered) -> Vec<u32> {
+    r.image
+        .rgba
+        .iter()
+        .chain(&r.image.variance)
+        .flatten()
+        .map(|x| x.to_bits())
+        .collect()
+}
