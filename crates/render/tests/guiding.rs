@@ -13,7 +13,9 @@
 
 mod common;
 
-use cirrus_render::{render, Crop, Extinction, GuidingMode, IntegratorKind, Lights, Medium, Phase};
+use cirrus_render::{
+    render, Crop, Extinction, GuidingMode, IntegratorKind, Lights, Medium, Phase, Rendered,
+};
 use glam::Vec3;
 
 fn sunlit_cloud(
@@ -163,16 +165,26 @@ fn guided_and_unguided_renders_agree_under_sun_and_sky() {
         s.guiding = mode;
         let guided = render(&scene, &s);
         assert!(guided.stats.counters.split_copies > 0, "{mode:?}");
-        // The pooled bias only (`common::assert_pooled_agreement`'s chi-square
-        // needs per-pixel standard errors the heavy-tailed guided weights
-        // underestimate; see `assert_furnace`).
-        for c in 0..3 {
-            let d = common::differences(&guided.image, &unguided.image, c);
-            assert!(d.diff.len() > 200, "channel {c}: {} pixels", d.diff.len());
-            let z = d.diff.iter().sum::<f64>() / d.var.iter().sum::<f64>().sqrt();
-            eprintln!("{mode:?} vs unguided, channel {c}: pooled z {z:.3}");
-            assert!(z.abs() <= 4.0, "{mode:?}, channel {c}: pooled z {z}");
-        }
+        assert_pooled_bias(&format!("{mode:?} under sun and sky"), &guided, &unguided);
+    }
+}
+
+/// Each channel's summed difference between a guided and an unguided
+/// render is within 4 of its standard errors: the pooled bias only
+/// (`common::assert_pooled_agreement`'s chi-square needs per-pixel
+/// standard errors the heavy-tailed guided weights underestimate; see
+/// `assert_furnace`).
+fn assert_pooled_bias(label: &str, guided: &Rendered, unguided: &Rendered) {
+    for c in 0..3 {
+        let d = common::differences(&guided.image, &unguided.image, c);
+        assert!(
+            d.diff.len() > 200,
+            "{label}, channel {c}: {} pixels",
+            d.diff.len()
+        );
+        let z = d.diff.iter().sum::<f64>() / d.var.iter().sum::<f64>().sqrt();
+        eprintln!("{label} against unguided, channel {c}: pooled z {z:.3}");
+        assert!(z.abs() <= 4.0, "{label}, channel {c}: pooled z {z}");
     }
 }
 
@@ -214,13 +226,7 @@ fn guided_and_unguided_renders_agree_under_an_hdr_map() {
         s.guiding = mode;
         let guided = render(&scene, &s);
         assert_eq!(guided.stats.counters.nonfinite_samples, 0, "{mode:?}");
-        for c in 0..3 {
-            let d = common::differences(&guided.image, &unguided.image, c);
-            assert!(d.diff.len() > 200, "channel {c}: {} pixels", d.diff.len());
-            let z = d.diff.iter().sum::<f64>() / d.var.iter().sum::<f64>().sqrt();
-            eprintln!("{mode:?} vs unguided under a map, channel {c}: pooled z {z:.3}");
-            assert!(z.abs() <= 4.0, "{mode:?}, channel {c}: pooled z {z}");
-        }
+        assert_pooled_bias(&format!("{mode:?} under a map"), &guided, &unguided);
     }
 }
 
