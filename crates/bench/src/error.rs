@@ -13,8 +13,9 @@
 //! sampler), configurations of the default one show what the sampler,
 //! adaptive sampling, guiding, light selection and denoising each give:
 //! independent random numbers instead of Sobol points, adaptive sampling
-//! at `--noise-threshold`, path guiding (`--guiding on`, its training
-//! counted in the time), a shadow ray to every light at each vertex
+//! at `--noise-threshold`, path guiding (`--guiding on`, roulette and
+//! splitting, and `--guiding directions`, guided directions as well; their
+//! training counted in the time), a shadow ray to every light at each vertex
 //! (`--light-sampling all`) instead of to one,
 //! and Open Image Denoise on the finished image (its time counted; left
 //! out, with a note, where the library does not load).
@@ -175,7 +176,11 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
     });
     v.push(Config {
         guiding: GuidingMode::On,
-        ..default("guided")
+        ..default("guided roulette and splitting")
+    });
+    v.push(Config {
+        guiding: GuidingMode::Directions,
+        ..default("guided directions")
     });
     v.push(Config {
         light_sampling: LightSampling::All,
