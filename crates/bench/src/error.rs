@@ -16,7 +16,9 @@
 //! at `--noise-threshold`, path guiding (`--guiding on`, roulette and
 //! splitting, and `--guiding directions`, guided directions as well; their
 //! training counted in the time), a shadow ray to every light at each vertex
-//! (`--light-sampling all`) instead of to one,
+//! (`--light-sampling all`) instead of to one, sunward scattering
+//! (`--sunward on`; every other row renders with it off, so that the
+//! estimators compare as Mitsuba and Cycles trace),
 //! and Open Image Denoise on the finished image (its time counted; left
 //! out, with a note, where the library does not load).
 
@@ -27,7 +29,7 @@ use crate::BenchResult;
 use ceiling::CollisionCost;
 use cirrus_render::{
     render, Adaptive, Budget, GuidingMode, IntegratorKind, LightSampling, MajorantMode, Medium,
-    RenderSettings, SamplerKind, Scene, TransmittanceEstimator, Volumes,
+    RenderSettings, SamplerKind, Scene, Sunward, TransmittanceEstimator, Volumes,
 };
 use cirrus_scene::{Scene as SceneFile, SceneFlags, VolumeCache};
 use std::fmt::Write as _;
@@ -96,6 +98,7 @@ struct Config {
     denoise: bool,
     guiding: GuidingMode,
     light_sampling: LightSampling,
+    sunward: Sunward,
 }
 
 impl Config {
@@ -112,6 +115,7 @@ impl Config {
             denoise: false,
             guiding: GuidingMode::Off,
             light_sampling: LightSampling::default(),
+            sunward: Sunward::Off,
         }
     }
 }
@@ -181,6 +185,10 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
     v.push(Config {
         guiding: GuidingMode::Directions,
         ..default("guided directions")
+    });
+    v.push(Config {
+        sunward: Sunward::On,
+        ..default("sunward scattering")
     });
     v.push(Config {
         light_sampling: LightSampling::All,
@@ -299,6 +307,7 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
         aovs: c.denoise,
         guiding: c.guiding,
         light_sampling: c.light_sampling,
+        sunward: c.sunward,
         progress: false,
         ..base.clone()
     };

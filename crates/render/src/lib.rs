@@ -82,7 +82,7 @@ pub use film::{AovImage, Image};
 pub use guiding::GuidingMode;
 pub use integrator::{
     AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, LightSampling,
-    PathTracer, RayMarcher, Sample, TwoPassMarcher,
+    PathTracer, RayMarcher, Sample, Sunward, TwoPassMarcher,
 };
 pub use light::{Environment, Lights, Sun};
 pub use medium::{

@@ -127,7 +127,8 @@ fn probe<M: Media>(
         settings.transmittance,
         settings.max_depth,
     )
-    .with_light_sampling(settings.light_sampling);
+    .with_light_sampling(settings.light_sampling)
+    .with_sunward(settings.sunward);
     let (w, h) = (camera.width().max(1), camera.height().max(1));
     let pixels = u64::from(w) * u64::from(h);
     // Each path has its own numbers and counts add, so the sum is the same

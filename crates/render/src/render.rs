@@ -110,7 +110,8 @@ fn render_with<M: Media>(
                 settings.max_depth,
             )
             .with_light_groups(!settings.compositing.light_groups.is_empty())
-            .with_light_sampling(settings.light_sampling);
+            .with_light_sampling(settings.light_sampling)
+            .with_sunward(settings.sunward);
             let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
             guiding_stats = Some(stats);
             let s = tracer.with_guide(guide.as_ref());
@@ -153,6 +154,10 @@ fn render_with<M: Media>(
         rays_per_second: counters.paths as f64 / wall_seconds.max(1e-9),
         guiding: guiding_stats,
         light_sampling,
+        sunward: match settings.integrator {
+            IntegratorKind::Path => settings.sunward.name().into(),
+            _ => String::new(),
+        },
         ..Default::default()
     };
     let crop = crop_of(settings, camera);

@@ -11,8 +11,8 @@ use crate::compositing::Compositing;
 use crate::control::RenderControl;
 use crate::error::{Error, Result};
 use crate::guiding::GuidingMode;
-use crate::integrator::LightSampling;
 use crate::integrator::{IntegratorKind, LightGridSettings};
+use crate::integrator::{LightSampling, Sunward};
 use crate::light::Lights;
 use crate::sampling::SamplerKind;
 use crate::shutter::Shutter;
@@ -117,6 +117,8 @@ pub struct RenderSettings {
     /// Whether next-event estimation samples every light at each vertex,
     /// or one ([`LightSampling`]).
     pub light_sampling: LightSampling,
+    /// Where the path tracer also scatters toward the sun ([`Sunward`]).
+    pub sunward: Sunward,
 }
 
 /// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
@@ -164,6 +166,7 @@ impl Default for RenderSettings {
             compositing: Compositing::default(),
             guiding: GuidingMode::Auto,
             light_sampling: LightSampling::Auto,
+            sunward: Sunward::Auto,
         }
     }
 }

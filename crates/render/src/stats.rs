@@ -45,6 +45,10 @@ pub struct Counters {
     /// roulette (`integrator/path_split.rs`).
     pub split_copies: u64,
     pub roulette_ends: u64,
+    /// Directions drawn toward the sun by sunward scattering
+    /// (`integrator/path_sunward.rs`), each a free flight and, where it
+    /// collides, a shadow ray.
+    pub sunward_rays: u64,
 }
 
 impl AddAssign for Counters {
@@ -65,6 +69,7 @@ impl AddAssign for Counters {
         self.env_samples += o.env_samples;
         self.split_copies += o.split_copies;
         self.roulette_ends += o.roulette_ends;
+        self.sunward_rays += o.sunward_rays;
     }
 }
 
@@ -91,6 +96,10 @@ pub struct RenderStats {
     /// The path tracer's next-event estimation: "all" or "one", with
     /// `auto` the choice ("auto: one"); empty for the marchers.
     pub light_sampling: String,
+    /// The path tracer's sunward scattering setting ("auto", "on",
+    /// "off"; `counters.sunward_rays` says how often it ran); empty for
+    /// the marchers.
+    pub sunward: String,
     pub width: u32,
     pub height: u32,
     /// Samples per pixel actually taken (with a time budget: reached).

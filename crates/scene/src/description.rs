@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    GuidingMode, IntegratorKind, LightSampling, MajorantMode, SamplerKind, TransmittanceEstimator,
-    VelocityUnit,
+    GuidingMode, IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward,
+    TransmittanceEstimator, VelocityUnit,
 };
 use serde::Deserialize;
 
@@ -105,6 +105,14 @@ declare_settings! {
     /// picks one under a sun and a constant sky, every light under a map.
     light_sampling: LightSampling, flag(long, value_enum), default(LightSampling::Auto),
         example(LightSampling::All);
+    /// Sunward scattering: at each scattering vertex, also scatter toward
+    /// the sun and gather its light at the next vertex, weighed against
+    /// the path's own next vertex (unbiased; about twice the shadow rays
+    /// of the vertices it runs at, for much less noise under a
+    /// forward-scattering phase function); `auto` runs it where the phase
+    /// function's mean cosine is at least 0.6, where it was measured to
+    /// pay.
+    sunward: Sunward, flag(long, value_enum), default(Sunward::Auto), example(Sunward::Off);
     /// Real scattering events per path (0: only the sky through the volume,
     /// 1: single scattering).
     max_depth: u32, flag(long), unset("unlimited, ended by Russian roulette"), example(1);

@@ -52,6 +52,7 @@ impl SceneSettings {
             majorant: r.majorant(),
             guiding: r.guiding(),
             light_sampling: r.light_sampling(),
+            sunward: r.sunward(),
             budget,
             seed: r.seed(),
             sampler: r.sampler(),

@@ -85,13 +85,21 @@ impl LightChoice {
     /// `phase`: [`Self::ALL`] unless `sampling` is `one` (resolved, see
     /// [`LightSampling::resolve`]) and both a sun and a sky light the scene.
     pub fn at(sampling: LightSampling, lights: &Lights, phase: &Phase, dir_in: Vec3) -> Self {
+        match &lights.sun {
+            Some(sun) => Self::facing_sun(sampling, lights, phase.eval(dir_in, -sun.direction())),
+            None => Self::ALL,
+        }
+    }
+
+    /// The pick at a vertex whose phase function toward the sun's centre
+    /// is `f_sun`.
+    pub fn facing_sun(sampling: LightSampling, lights: &Lights, f_sun: f32) -> Self {
         let (Some(sun), Some(env), LightSampling::One) =
             (&lights.sun, &lights.environment, sampling)
         else {
             return Self::ALL;
         };
-        let to_sun = -sun.direction();
-        let sun_light = luminance(sun.irradiance()) * phase.eval(dir_in, to_sun);
+        let sun_light = luminance(sun.irradiance()) * f_sun;
         let sky_light = luminance(env.mean_radiance());
         let p = sun_light / (sun_light + sky_light);
         let p = if p.is_finite() { p } else { 0.5 };

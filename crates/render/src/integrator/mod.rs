@@ -14,12 +14,14 @@ mod path;
 mod path_light;
 mod path_scatter;
 mod path_split;
+mod path_sunward;
 mod raymarch;
 mod raymarch2pass;
 
 pub use light_choice::LightSampling;
 pub use light_grid::{LightGrid, LightGridSettings};
 pub use path::PathTracer;
+pub use path_sunward::{Sunward, FORWARD_MEAN_COSINE, KEEP_THRESHOLD};
 pub use raymarch::RayMarcher;
 pub use raymarch2pass::TwoPassMarcher;
 

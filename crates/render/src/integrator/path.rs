@@ -1,12 +1,13 @@
 //! Volumetric path tracing: the path loop (`path.rs`), next-event
-//! estimation (`path_light.rs`) and the scattered direction, guided or
-//! not (`path_scatter.rs`).
+//! estimation (`path_light.rs`), the scattered direction, guided or not
+//! (`path_scatter.rs`), and sunward scattering (`path_sunward.rs`).
 
 use glam::Vec3;
 
 use super::light_choice::{LightChoice, LightSampling};
 use super::path_light::Vertex;
 use super::path_split::{At, Pending};
+use super::path_sunward::{Arrival, Sunward};
 use super::{escaped_radiance, AovSample, CameraSampler, LightParts, Sample};
 use crate::compositing::{tag, GroupRadiance, LightGroup};
 use crate::guiding::{Guide, Ignore, Learner};
@@ -68,6 +69,11 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   may be drawn from the mixture of the phase function and the learned
 ///   product (`path_scatter.rs`), whose density NEE's MIS weights and
 ///   escaped light's take. Without one, the phase function alone.
+/// - Sunward scattering ([`Sunward`], `path_sunward.rs`): at a vertex
+///   with a forward-peaked phase function under a sun, a second direction
+///   drawn from the phase lobe about the sun gathers the sun's light at
+///   its collision, weighed by MIS against the sun's next-event estimate
+///   at the path's own next vertex (which takes the complementary weight).
 /// - Emission: at every real collision, with the instance chosen with
 ///   probability `sigma_t,i / sigma_t` ([`Media::interaction`]), the
 ///   path adds `beta * (1 - albedo_i) * Le_i`. Delta tracking samples the
@@ -80,13 +86,16 @@ pub struct PathTracer<'a, M> {
     pub(super) medium: &'a M,
     pub(super) lights: Lights,
     pub(super) estimator: TransmittanceEstimator,
-    max_depth: Option<u32>,
+    pub(super) max_depth: Option<u32>,
     chromatic: bool,
     /// Tag contributions with their light groups (off: `Sample::groups`
     /// stays zero and costs nothing).
     light_groups: bool,
     guide: Option<&'a Guide>,
-    light_sampling: LightSampling,
+    pub(super) light_sampling: LightSampling,
+    /// Where the next vertex's sunlight is gathered by sunward scattering
+    /// as well ([`Sunward`]).
+    pub(super) sunward: Sunward,
 }
 
 impl<'a, M: Media> PathTracer<'a, M> {
@@ -106,6 +115,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             chromatic: medium.chromatic(),
             light_groups: false,
             guide: None,
+            sunward: Sunward::default(),
         }
     }
 
@@ -123,6 +133,12 @@ impl<'a, M: Media> PathTracer<'a, M> {
             light_sampling: light_sampling.resolve(&self.lights),
             ..self
         }
+    }
+
+    /// Gathers the next vertex's sunlight by sunward scattering as well
+    /// where `sunward` says.
+    pub fn with_sunward(self, sunward: Sunward) -> Self {
+        Self { sunward, ..self }
     }
 
     /// Follows `guide` where it has learned.
@@ -189,6 +205,8 @@ pub(super) struct Path {
     /// scattering vertex: the centre of its roulette and splitting weight
     /// window (0 until then, or where nothing was learned).
     pub(super) expected: f32,
+    /// How the current ray's direction was drawn.
+    pub(super) arrival: Arrival,
     pub(super) out: Sample,
 }
 
@@ -213,6 +231,19 @@ impl Path {
     }
 }
 
+impl Path {
+    /// Adds sunlight `e` (throughput included) gathered beside the path's
+    /// own vertices.
+    #[inline]
+    fn add_sun(&mut self, e: Vec3, groups: bool, learner: &mut impl Learner) {
+        self.out.radiance += e;
+        learner.contribute(e);
+        if groups {
+            tag(&mut self.out.groups, LightGroup::Sun, e);
+        }
+    }
+}
+
 impl<M: Media> PathTracer<'_, M> {
     /// One camera path, tracked per channel of `S`.
     fn trace<S: Spectrum>(
@@ -231,6 +262,7 @@ impl<M: Media> PathTracer<'_, M> {
             escape: Escape::Full,
             emission_only: false,
             expected: 0.0,
+            arrival: Arrival::default(),
             out: Sample {
                 radiance: Vec3::ZERO,
                 alpha: 0.0,
@@ -415,6 +447,7 @@ impl<M: Media> PathTracer<'_, M> {
             guide: light,
             index: vertex,
             choice: LightChoice::at(self.light_sampling, &self.lights, at.phase, ray_in.dir),
+            arrival: path.arrival,
         };
         let parts = self.direct_light::<S>(&v, draws, c);
         let direct = path.beta * parts.total();
@@ -428,10 +461,24 @@ impl<M: Media> PathTracer<'_, M> {
             }
             path.emission_only = true;
         }
+        // The sunward strategy gathers the next vertex's sunlight beside
+        // the continuation (`path_sunward.rs`).
+        let guided_directions = guide.is_some_and(|g| g.decisions().directions);
+        let lobe = self.sunward_lobe(path, at, ray_in.dir, guided_directions);
+        if let Some(lobe) = &lobe {
+            let e = self.sunward::<S>(path, at, lobe, &ray_in, draws, c);
+            path.add_sun(e, self.light_groups, learner);
+        }
         let s = self.scatter(&ray_in, at.phase, light, vertex, draws);
         if light.is_some() {
             path.beta *= s.weight;
         }
+        path.arrival = Arrival {
+            scatter_pdf: s.pdf,
+            // Without a guided product the continuation's density is the
+            // phase function's.
+            sunward_pdf: lobe.map_or(0.0, |l| self.sunward_pdf(&l, s.dir, s.pdf)),
+        };
         path.escape = Escape::Mis(s.pdf, v.choice);
         path.ray = ray_in.spawn(p, s.dir);
         if let Some((_, site)) = site {

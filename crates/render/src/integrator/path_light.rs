@@ -8,6 +8,7 @@ use glam::Vec3;
 use super::light_choice::LightChoice;
 use super::path::PathTracer;
 use super::path_scatter::mixture_pdf;
+use super::path_sunward::Arrival;
 use super::LightParts;
 use crate::guiding::BinDistribution;
 use crate::light::LightSample;
@@ -35,6 +36,9 @@ pub(super) struct Vertex<'a> {
     pub index: u32,
     /// The probability that each light is sampled here.
     pub choice: LightChoice,
+    /// How the path arrived here, for the sun's weight against sunward
+    /// scattering at the previous vertex.
+    pub arrival: Arrival,
 }
 
 impl<M: Media> PathTracer<'_, M> {
@@ -58,7 +62,8 @@ impl<M: Media> PathTracer<'_, M> {
             let (u1, u2) = draws.get_2d(Draw::SunDirection, v.index);
             let s = sun.sample(u1, u2);
             c.nee_rays_sun += 1;
-            l.sun = self.light_term::<S>(v, s, v.choice.sun, Draw::SunShadow, draws, c);
+            let weight = v.arrival.sun_weight(v.choice.sun);
+            l.sun = weight * self.light_term::<S>(v, s, v.choice.sun, Draw::SunShadow, draws, c);
         }
         if let Some(env) = self.lights.environment.as_ref().filter(|_| sky_picked) {
             let (u1, u2) = draws.get_2d(Draw::SkyDirection, v.index);
