@@ -4,6 +4,7 @@
 //! it (CI installs it from PyPI's pyoidn); without it the test says so and
 //! passes, since a default build needs nothing of the library.
 
+use cirrus_render::Sunward;
 use cirrus_scene::{ErrorKind, Overrides, Scene};
 
 fn cloud() -> Scene {
@@ -18,6 +19,12 @@ fn render(spp: u32, seed: u64, denoise: bool) -> Result<Vec<[f32; 4]>, cirrus_sc
         spp: Some(spp),
         seed: Some(seed),
         denoise: Some(denoise),
+        // The plain path tracer's noise, which the 5x below is set against:
+        // sunward scattering (the default here) leaves 0.68x the noise at
+        // 16 spp, and a denoiser cuts less of a smaller error (measured
+        // 6.1x without it, 4.5x with it, the denoised error 1.32e-4 and
+        // 1.22e-4 against a 1024-spp reference).
+        sunward: Some(Sunward::Off),
         ..Default::default()
     });
     Ok(scene.render()?.image.rgba)
