@@ -14,7 +14,7 @@
 mod common;
 
 use cirrus_render::{
-    render, Crop, Extinction, GuidingMode, IntegratorKind, Lights, Medium, Phase, Rendered,
+    render, Extinction, GuidingMode, IntegratorKind, Lights, Medium, Phase, Rendered,
 };
 use glam::Vec3;
 
@@ -65,27 +65,10 @@ fn same_on_any_thread_count_and_in_crops(mode: GuidingMode) {
     assert!(stats.regions > 1, "the cache never split: {stats:?}");
     assert!(stats.memory_bytes > 0 && stats.records > 0, "{stats:?}");
 
-    let crop = Crop {
-        x0: 3,
-        y0: 5,
-        x1: 17,
-        y1: 12,
-    };
-    s.crop = Some(crop);
+    s.crop = Some(common::CROP);
     s.tile_size = 4;
     let part = common::with_threads(2, || render(&scene, &s));
-    let (w, fw) = (part.image.width, two.image.width);
-    for y in 0..part.image.height {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            let j = ((y + crop.y0) * fw + x + crop.x0) as usize;
-            assert_eq!(
-                part.image.rgba[i].map(f32::to_bits),
-                two.image.rgba[j].map(f32::to_bits),
-                "{mode:?}: crop pixel ({x}, {y})"
-            );
-        }
-    }
+    common::assert_crop_of(&format!("{mode:?}"), &part, &two, common::CROP);
 }
 
 /// Every pixel of a non-absorbing medium under a uniform sky of radiance

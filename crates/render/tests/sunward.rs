@@ -14,8 +14,7 @@
 mod common;
 
 use cirrus_render::{
-    render, Crop, Emission, Extinction, IntegratorKind, LightSampling, Lights, Medium, Phase,
-    Sunward,
+    render, Emission, Extinction, IntegratorKind, LightSampling, Lights, Medium, Phase, Sunward,
 };
 use glam::Vec3;
 
@@ -117,27 +116,10 @@ fn sunward_renders_are_the_same_on_any_thread_count_and_in_crops() {
     let two = common::with_threads(2, || render(&scene, &s));
     assert!(two.stats.counters.sunward_rays > 0);
     assert_eq!(common::image_bits(&one), common::image_bits(&two));
-    let crop = Crop {
-        x0: 3,
-        y0: 5,
-        x1: 17,
-        y1: 12,
-    };
-    s.crop = Some(crop);
+    s.crop = Some(common::CROP);
     s.tile_size = 4;
     let part = render(&scene, &s);
-    let (w, fw) = (part.image.width, two.image.width);
-    for y in 0..part.image.height {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            let j = ((y + crop.y0) * fw + x + crop.x0) as usize;
-            assert_eq!(
-                part.image.rgba[i].map(f32::to_bits),
-                two.image.rgba[j].map(f32::to_bits),
-                "crop pixel ({x}, {y})"
-            );
-        }
-    }
+    common::assert_crop_of("sunward", &part, &two, common::CROP);
 }
 
 #[test]

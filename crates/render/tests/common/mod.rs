@@ -3,8 +3,8 @@
 
 use cirrus_render::Bounds3;
 use cirrus_render::{
-    render, Budget, Camera, Environment, GridField, Image, IntegratorKind, Lights, Media, Medium,
-    RenderSettings, Rendered, Scene, Sun, Volumes,
+    render, Budget, Camera, Crop, Environment, GridField, Image, IntegratorKind, Lights, Media,
+    Medium, RenderSettings, Rendered, Scene, Sun, Volumes,
 };
 use glam::Vec3;
 
@@ -181,4 +181,29 @@ pub fn image_bits(r: &Rendered) -> Vec<u32> {
         .flatten()
         .map(|x| x.to_bits())
         .collect()
+}
+
+/// A crop window inside every 20x20 test image, off its tile grid.
+pub const CROP: Crop = Crop {
+    x0: 3,
+    y0: 5,
+    x1: 17,
+    y1: 12,
+};
+
+/// Every pixel of `part`, a render of `crop`, has the bits of the same
+/// pixel of `full`.
+pub fn assert_crop_of(label: &str, part: &Rendered, full: &Rendered, crop: Crop) {
+    let (w, fw) = (part.image.width, full.image.width);
+    for y in 0..part.image.height {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let j = ((y + crop.y0) * fw + x + crop.x0) as usize;
+            assert_eq!(
+                part.image.rgba[i].map(f32::to_bits),
+                full.image.rgba[j].map(f32::to_bits),
+                "{label}: crop pixel ({x}, {y})"
+            );
+        }
+    }
 }
