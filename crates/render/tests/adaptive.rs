@@ -4,7 +4,7 @@
 mod common;
 
 use cirrus_render::{
-    render, Adaptive, Budget, Crop, GridField, IntegratorKind, Lights, RenderSettings, Rendered,
+    render, Adaptive, Budget, GridField, IntegratorKind, Lights, RenderSettings, Rendered,
     SamplerKind, Scene, Volumes,
 };
 use glam::Vec3;
@@ -166,31 +166,10 @@ fn adaptive_crops_are_bit_identical_to_the_full_render() {
     let mut s = adaptive(128, 9, 0.05, 8);
     s.tile_size = 7;
     let full = render(&scene, &s);
-    let crop = Crop {
-        x0: 3,
-        y0: 5,
-        x1: 17,
-        y1: 12,
-    };
-    s.crop = Some(crop);
+    s.crop = Some(common::CROP);
     s.tile_size = 4;
     let part = common::with_threads(2, || render(&scene, &s));
-    let (w, fw) = (part.image.width, full.image.width);
-    for y in 0..part.image.height {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            let j = ((y + crop.y0) * fw + x + crop.x0) as usize;
-            assert_eq!(
-                part.image.rgba[i].map(f32::to_bits),
-                full.image.rgba[j].map(f32::to_bits)
-            );
-            assert_eq!(
-                part.image.variance[i].map(f32::to_bits),
-                full.image.variance[j].map(f32::to_bits)
-            );
-            assert_eq!(part.image.samples[i], full.image.samples[j]);
-        }
-    }
+    common::assert_crop_of("adaptive", &part, &full, common::CROP);
 }
 
 /// With a time budget, passes go to the pixels of highest error, and the

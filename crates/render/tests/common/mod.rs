@@ -192,17 +192,27 @@ pub const CROP: Crop = Crop {
 };
 
 /// Every pixel of `part`, a render of `crop`, has the bits of the same
-/// pixel of `full`.
+/// pixel of `full`: its value, its variance and its sample count.
 pub fn assert_crop_of(label: &str, part: &Rendered, full: &Rendered, crop: Crop) {
     let (w, fw) = (part.image.width, full.image.width);
     for y in 0..part.image.height {
         for x in 0..w {
             let i = (y * w + x) as usize;
             let j = ((y + crop.y0) * fw + x + crop.x0) as usize;
+            let (a, b) = (&part.image, &full.image);
             assert_eq!(
-                part.image.rgba[i].map(f32::to_bits),
-                full.image.rgba[j].map(f32::to_bits),
+                a.rgba[i].map(f32::to_bits),
+                b.rgba[j].map(f32::to_bits),
                 "{label}: crop pixel ({x}, {y})"
+            );
+            assert_eq!(
+                a.variance[i].map(f32::to_bits),
+                b.variance[j].map(f32::to_bits),
+                "{label}: crop pixel ({x}, {y})'s variance"
+            );
+            assert_eq!(
+                a.samples[i], b.samples[j],
+                "{label}: crop pixel ({x}, {y})'s samples"
             );
         }
     }
