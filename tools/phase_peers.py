@@ -26,7 +26,8 @@ against the fraction Student's t predicts from noise alone, and 8x8-block z-scor
 Pixels with no noise in either renderer (sky beside the cloud) must agree to 1e-4.
 
 `efficiency`: one scene (`--scene sunsky`: HG g 0.5, albedo 0.9, sun 0.53 deg + sky, unlimited
-depth; `--scene thick`: albedo 0.999, HG g 0.8, a delta sun + sky), cirrus in one or more labelled
+depth; `--scene thick`: albedo 0.999, HG g 0.8, a delta sun + sky; `--scene sky`: as sunsky without
+the sun), cirrus in one or more labelled
 configurations (`--cirrus-config`), Cycles unguided and, with `--cycles-guiding`, guided; a
 converged reference from two long cirrus renders with other seeds (its own noise, estimated
 from their difference, is subtracted from every MSE); each renderer at several spp, unbiased
@@ -91,6 +92,9 @@ for depth, suffix, cs, ps, ms in (([], "ms", 256, 64, 32), (["--max-depth", "1"]
           VIEW + SUN + ["--sun-angle", "0", "--phase", "hg2", "--g", "0.8", "--g2", "-0.3", "--lobe-weight", "0.8"]
           + depth, cs, ms)
     _case(f"rayleigh_{suffix}", "mitsuba", VIEW + SUN + ["--sun-angle", "0", "--phase", "rayleigh"] + depth, cs, ms)
+    # Forward enough (g 0.8) that `--sunward auto` scatters toward the sun at every vertex.
+    _case(f"hg08_sunsky_{suffix}", "cycles", VIEW + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.8"] + depth,
+          cs, ps)
 
 # Diagnostics: the sun alone (no sky), single scattering, delta sun, HG against Mie: the sun's
 # single scattering at one fixed scattering angle per pixel isolates the phase function's value.
@@ -410,7 +414,9 @@ EFF_FLAGS = VIEW + SUN + ["--sun-angle", "0.53", "--phase", "hg", "--g", "0.5"]
 # through its core), albedo 0.999, HG g 0.8, a delta sun and the sky.
 THICK_FLAGS = [f for f in VIEW] + SUN + ["--sun-angle", "0", "--phase", "hg", "--g", "0.8"]
 THICK_FLAGS[THICK_FLAGS.index("--albedo") + 1] = "0.999"
-SCENES = {"sunsky": EFF_FLAGS, "thick": THICK_FLAGS}
+# The same thin cloud under the constant sky alone (the agreement case hg_sky_ms).
+SKY_FLAGS = VIEW + ["--no-sun", "--phase", "hg", "--g", "0.5"]
+SCENES = {"sunsky": EFF_FLAGS, "thick": THICK_FLAGS, "sky": SKY_FLAGS}
 
 
 def efficiency(args) -> int:
