@@ -3,7 +3,7 @@
 # clean, in one command on a fresh machine: builds the `cirrus` binary,
 # installs Intel Open Image Denoise (PyPI's pyoidn into target/venv, by
 # tools/oidn.sh) and renders 16 samples per pixel denoised with the albedo
-# as guide (512x512, about 10 s on a 2-core machine after the build).
+# as guide (512x512, about 11 s on a 2-core machine after the build).
 #
 #   usage: bash tools/render_default.sh [OUT_STEM] [more `cirrus render` flags]
 #

@@ -91,16 +91,7 @@ fn render_with<M: Media>(
     let mut counters = Counters::default();
     let mut guiding_stats = None;
     let lights = lights.clone();
-    let light_sampling = match (settings.integrator, settings.light_sampling) {
-        (IntegratorKind::Path, LightSampling::Auto) => {
-            format!(
-                "auto: {}",
-                LightSampling::Auto.resolve(&lights.clone().pruned()).name()
-            )
-        }
-        (IntegratorKind::Path, mode) => mode.name().into(),
-        _ => String::new(),
-    };
+    let mut light_sampling = String::new();
     let (image, aovs, layers, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
             let tracer = PathTracer::new(
@@ -112,6 +103,12 @@ fn render_with<M: Media>(
             .with_light_groups(!settings.compositing.light_groups.is_empty())
             .with_light_sampling(settings.light_sampling)
             .with_sunward(settings.sunward);
+            let grid_start = Instant::now();
+            let shadows = tracer
+                .picks_one_light()
+                .then(|| LightGrid::for_light_choice(medium, &lights, settings.seed));
+            light_sampling = light_sampling_stat(settings, &lights, shadows.as_ref(), grid_start);
+            let tracer = tracer.with_shadows(shadows.as_ref());
             let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
             guiding_stats = Some(stats);
             let s = tracer.with_guide(guide.as_ref());
@@ -173,6 +170,31 @@ fn render_with<M: Media>(
         aovs,
         noisy: None,
         layers,
+    }
+}
+
+/// `--stats`' light sampling: the mode (what `auto` chose), and the shadow
+/// grid the pick weighs lights by, its lattice and build time.
+fn light_sampling_stat(
+    settings: &RenderSettings,
+    lights: &Lights,
+    grid: Option<&LightGrid>,
+    grid_start: Instant,
+) -> String {
+    let mode = match settings.light_sampling {
+        LightSampling::Auto => format!(
+            "auto: {}",
+            LightSampling::Auto.resolve(&lights.clone().pruned()).name()
+        ),
+        mode => mode.name().into(),
+    };
+    match grid {
+        Some(g) => {
+            let [x, y, z] = g.lattice();
+            let seconds = grid_start.elapsed().as_secs_f64();
+            format!("{mode}, through a {x}x{y}x{z} shadow grid ({seconds:.2} s)")
+        }
+        None => mode,
     }
 }
 

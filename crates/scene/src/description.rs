@@ -100,9 +100,10 @@ declare_settings! {
     guiding: GuidingMode, flag(long, value_enum), default(GuidingMode::Auto),
         example(GuidingMode::On);
     /// Next-event estimation at each scattering vertex: a shadow ray to
-    /// one light picked by its unoccluded in-scattered light there (half
-    /// the shadow rays under a sun and a sky), or to every light; `auto`
-    /// picks one under a sun and a constant sky, every light under a map.
+    /// one light picked by its in-scattered light there seen through the
+    /// media (a coarse shadow grid; half the shadow rays under a sun and a
+    /// sky, and few deep in a thick cloud), or to every light; `auto` picks
+    /// one under a constant sky, every light under a map.
     light_sampling: LightSampling, flag(long, value_enum), default(LightSampling::Auto),
         example(LightSampling::All);
     /// Sunward scattering: at each scattering vertex, also scatter toward

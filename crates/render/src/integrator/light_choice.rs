@@ -5,17 +5,29 @@
 //! sample by the probability of the pick, as pbrt-v4's light samplers and
 //! Cycles' light tree do: the shadow rays, the larger part of a path's
 //! tracking in a cloud lit by a sun and a sky, are halved, at the price of
-//! the noise of the pick. The pick follows each light's unoccluded
-//! in-scattered radiance at the vertex, `E_sun f(w_in, w_sun)` against the
+//! the noise of the pick. Without a shadow grid (below) the pick follows
+//! each light's unoccluded in-scattered radiance at the vertex, `E_sun f(w_in, w_sun)` against the
 //! sky's mean radiance (the phase function integrates to 1 over the
 //! sphere), so a forward-scattering vertex facing the sun takes the sun and
 //! one facing away takes the sky; a probability is kept within
 //! [`MIN_PROBABILITY`, 1 - `MIN_PROBABILITY`] so neither light's weight
 //! exceeds `1 / MIN_PROBABILITY`.
 //!
+//! Through the media: inside a thick cloud nine in ten shadow rays bring
+//! nothing back (measured on the thick benchmark cloud: the sun's and the
+//! sky's alike). So the path tracer's renders give the pick a coarse grid of each
+//! light's transmittance ([`LightGrid::for_light_choice`]): the lights are
+//! weighed by their in-scattered radiance seen through the media, and a
+//! vertex that expects less than [`TRACE_FRACTION`] of its unoccluded
+//! light traces a shadow ray only with probability in proportion (at least
+//! [`MIN_TRACE`]), the pick's probabilities then summing to less than one.
+//! Any probabilities are exact so long as every weight uses them: the
+//! grid only moves the noise, never the mean.
+//!
 //! `auto` (the default) picks one light where that was measured to pay, a
-//! sun beside a constant sky (1.25-1.35x the efficiency of `all` on the
-//! corpus cloud, thin and thick: BENCHMARKS.md, "One light per vertex"),
+//! constant sky with or without a sun (1.25-1.35x the efficiency of `all`
+//! on the corpus cloud under both, thin and thick, and the shadow grid
+//! 1.14-1.8x more: BENCHMARKS.md, "One light per vertex"),
 //! and samples every light under an HDR map, whose hot texels divided by
 //! a small pick probability make fireflies that were not measured away.
 //!
@@ -28,6 +40,7 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use super::light_grid::LightGrid;
 use crate::guiding::luminance;
 use crate::light::Lights;
 use crate::phase::Phase;
@@ -37,13 +50,14 @@ use crate::phase::Phase;
 #[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum LightSampling {
-    /// `one` under a sun and a constant sky, `all` otherwise.
+    /// `one` under a constant sky (with or without a sun), `all` otherwise.
     #[default]
     Auto,
     /// Every light, one sample each.
     All,
-    /// One light, picked in proportion to its unoccluded in-scattered
-    /// radiance at the vertex.
+    /// One light (or, deep in the media, most often none), picked in
+    /// proportion to its in-scattered radiance at the vertex seen through
+    /// the media.
     One,
 }
 
@@ -68,6 +82,18 @@ impl LightSampling {
 
 /// A pick probability is at least this.
 pub const MIN_PROBABILITY: f32 = 0.05;
+
+/// A vertex whose lights, seen through the media, bring at least this
+/// fraction of their unoccluded in-scattered radiance always traces a
+/// shadow ray; one that expects less traces in proportion. Measured at 64
+/// spp (BENCHMARKS.md, "One light per vertex"): 0.1 and 0.3 alike, 1 lost
+/// 1.5x on a thinner cloud (too many lit vertices left without light).
+pub const TRACE_FRACTION: f32 = 0.3;
+
+/// ... and every vertex traces with at least this probability, so that
+/// where the coarse shadow grid is wrong a traced sample's weight stays
+/// at most 20x.
+pub const MIN_TRACE: f32 = 0.05;
 
 /// The probability that a vertex's next-event estimation samples each
 /// light (1 for both under `all`: each light is sampled once).
@@ -107,6 +133,52 @@ impl LightChoice {
         LightChoice {
             sun: p,
             sky: 1.0 - p,
+        }
+    }
+
+    /// The pick at `p`, reached along `dir_in` with phase function
+    /// `phase` (`one`: a sun, a sky or both), with each light's in-scattered
+    /// radiance there as `grid` estimates it through the media; and no
+    /// light at all, with the remaining probability, where the grid
+    /// expects less than [`TRACE_FRACTION`] of the unoccluded light.
+    pub fn shadowed(
+        lights: &Lights,
+        grid: &LightGrid,
+        phase: &Phase,
+        p: Vec3,
+        dir_in: Vec3,
+    ) -> Self {
+        let sun_open = lights.sun.as_ref().map_or(0.0, |sun| {
+            luminance(sun.irradiance()) * phase.eval(dir_in, -sun.direction())
+        });
+        let sky_open = lights
+            .environment
+            .as_ref()
+            .map_or(0.0, |env| luminance(env.mean_radiance()));
+        let seen = grid.in_scatter(phase, lights, p, dir_in);
+        let (sun_seen, sky_seen) = (luminance(seen.sun), luminance(seen.sky));
+        let trace = (sun_seen + sky_seen) / (TRACE_FRACTION * (sun_open + sky_open));
+        let trace = if trace.is_finite() {
+            trace.clamp(MIN_TRACE, 1.0)
+        } else {
+            1.0
+        };
+        let p_sun = match (&lights.sun, &lights.environment) {
+            (Some(_), Some(_)) => {
+                let p_sun = if sun_seen + sky_seen > 0.0 {
+                    sun_seen / (sun_seen + sky_seen)
+                } else {
+                    sun_open / (sun_open + sky_open)
+                };
+                let p_sun = if p_sun.is_finite() { p_sun } else { 0.5 };
+                p_sun.clamp(MIN_PROBABILITY, 1.0 - MIN_PROBABILITY)
+            }
+            (Some(_), None) => 1.0,
+            _ => 0.0,
+        };
+        LightChoice {
+            sun: trace * p_sun,
+            sky: trace * (1.0 - p_sun),
         }
     }
 
@@ -177,5 +249,52 @@ mod tests {
             ..l.clone()
         };
         assert!(LightChoice::at(LightSampling::One, &sun_only, &phase, Vec3::X).is_all());
+    }
+
+    /// A cube of uniform density 4 over [0, 4]^3 (optical depth 16 across),
+    /// its shadow grid under `lights`.
+    fn cube_grid(lights: &Lights) -> LightGrid {
+        use crate::medium::{GridField, Medium};
+        let field = GridField::from_fn([32; 3], Vec3::splat(0.0625), 0.125, 4, |_, _, _| 1.0);
+        let cube = crate::volumes::Volumes::from(Medium::new(field, 4.0, Vec3::splat(0.9), 0.5));
+        LightGrid::for_light_choice(&cube, lights, 7)
+    }
+
+    /// Deep in the cube a vertex traces a shadow ray with the least
+    /// probability; just under the sunlit face, always, with the sun
+    /// weighed by the light the grid sees there; and with one light, that
+    /// light alone, as often as the grid says.
+    #[test]
+    fn the_shadowed_pick_traces_where_the_grid_sees_light() {
+        let l = lights();
+        let grid = cube_grid(&l);
+        let phase = Phase::hg(0.5);
+        let dir_in = Vec3::new(0.3, 0.5, -0.2).normalize();
+        let deep = LightChoice::shadowed(&l, &grid, &phase, Vec3::splat(2.0), dir_in);
+        assert!((deep.sun + deep.sky - MIN_TRACE).abs() < 1e-6, "{deep:?}");
+        assert!(deep.sun >= MIN_PROBABILITY * MIN_TRACE && deep.sky >= MIN_PROBABILITY * MIN_TRACE);
+        // The sun shines down (+y is toward it): 0.05 below the top face.
+        let top = Vec3::new(2.0, 3.95, 2.0);
+        let lit = LightChoice::shadowed(&l, &grid, &phase, top, dir_in);
+        assert!((lit.sun + lit.sky - 1.0).abs() < 1e-6, "{lit:?}");
+        let seen = grid.in_scatter(&phase, &l, top, dir_in);
+        let share = luminance(seen.sun) / (luminance(seen.sun) + luminance(seen.sky));
+        let share = share.clamp(MIN_PROBABILITY, 1.0 - MIN_PROBABILITY);
+        assert!((lit.sun - share).abs() < 1e-5, "{lit:?} against {share}");
+        // An open sky above the face lets in more than the sun's share of
+        // it, which the unoccluded pick would have given the sun.
+        let open = LightChoice::at(LightSampling::One, &l, &phase, dir_in);
+        assert!(lit.sun != open.sun, "{lit:?} {open:?}");
+        let sky_only = Lights {
+            sun: None,
+            ..l.clone()
+        };
+        let grid = cube_grid(&sky_only);
+        let deep = LightChoice::shadowed(&sky_only, &grid, &phase, Vec3::splat(2.0), dir_in);
+        assert_eq!(deep.sun, 0.0);
+        assert!((deep.sky - MIN_TRACE).abs() < 1e-6, "{deep:?}");
+        let edge = LightChoice::shadowed(&sky_only, &grid, &phase, top, dir_in);
+        assert_eq!(edge.sun, 0.0);
+        assert!(edge.sky > 10.0 * MIN_TRACE && edge.sky <= 1.0, "{edge:?}");
     }
 }

@@ -17,6 +17,13 @@ const BRICK_POINTS: usize = BRICK * BRICK * BRICK;
 /// Keeps the light grid's random streams apart from the camera samples'.
 const GRID_DOMAIN: u64 = 0x4c49_4748_5447_5244;
 
+/// The light choice's grid spacing in voxels...
+const CHOICE_CELL_VOXELS: f32 = 8.0;
+/// ...unless that puts fewer points than this along the longest axis...
+const CHOICE_MIN_POINTS: f32 = 16.0;
+/// ...or more than this.
+const CHOICE_MAX_POINTS: f32 = 64.0;
+
 /// Resolution and quality of the two-pass light grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightGridSettings {
@@ -128,6 +135,38 @@ impl LightGrid {
             })
             .collect();
         grid
+    }
+
+    /// The coarse grid the path tracer's light choice weighs lights by
+    /// (`light_choice.rs`): lattice points 8 voxels apart, at least 16
+    /// along the longest axis of a small volume and at most 64 along that
+    /// of a large one (its cost bounded at any size),
+    /// marched at half that spacing, four sky directions per point. Coarse
+    /// is enough: its values only decide probabilities.
+    pub fn for_light_choice<M: Media>(medium: &M, lights: &Lights, seed: u64) -> Self {
+        let voxel = medium.voxel_size();
+        let voxels_across = medium.bounds().size().max_element() / voxel;
+        let cell_voxels = CHOICE_CELL_VOXELS
+            .min(voxels_across / CHOICE_MIN_POINTS)
+            .max(voxels_across / CHOICE_MAX_POINTS);
+        let settings = LightGridSettings {
+            cell_voxels,
+            env_directions: 4,
+        };
+        let mut uncounted = Counters::default();
+        Self::build(
+            medium,
+            lights,
+            0.5 * cell_voxels,
+            &settings,
+            seed,
+            &mut uncounted,
+        )
+    }
+
+    /// Lattice points along each axis.
+    pub fn lattice(&self) -> [usize; 3] {
+        self.points
     }
 
     /// Number of bricks holding light (for reporting sparsity); each

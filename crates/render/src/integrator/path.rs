@@ -5,6 +5,7 @@
 use glam::Vec3;
 
 use super::light_choice::{LightChoice, LightSampling};
+use super::light_grid::LightGrid;
 use super::path_light::Vertex;
 use super::path_split::{At, Pending};
 use super::path_sunward::{Arrival, Sunward};
@@ -13,6 +14,7 @@ use crate::compositing::{tag, GroupRadiance, LightGroup};
 use crate::guiding::{Guide, Ignore, Learner};
 use crate::light::Lights;
 use crate::medium::{Interaction, Media};
+use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::{Draw, Rng, SampleStream};
 use crate::spectrum::Spectrum;
@@ -37,7 +39,8 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   terminating instead.
 /// - Next-event estimation at every scattering event: one sample of the
 ///   sun (if any) and one of the environment (if any), or of one of them
-///   picked at random ([`LightSampling`]), each shadow ray's
+///   picked at random ([`LightSampling`]; weighed through the media by a
+///   shadow grid where one is given, and then sometimes none), each shadow ray's
 ///   transmittance estimated by the chosen estimator. Directions from a
 ///   light sampler and from phase sampling are combined with the power
 ///   heuristic (Veach 1997); a delta sun gets NEE only. At the last
@@ -96,6 +99,9 @@ pub struct PathTracer<'a, M> {
     /// Where the next vertex's sunlight is gathered by sunward scattering
     /// as well ([`Sunward`]).
     pub(super) sunward: Sunward,
+    /// Each light's transmittance through the media, which the light
+    /// choice weighs lights by (`light_choice.rs`).
+    pub(super) shadows: Option<&'a LightGrid>,
 }
 
 impl<'a, M: Media> PathTracer<'a, M> {
@@ -116,6 +122,34 @@ impl<'a, M: Media> PathTracer<'a, M> {
             light_groups: false,
             guide: None,
             sunward: Sunward::default(),
+            shadows: None,
+        }
+    }
+
+    /// Picks the light at each vertex with its transmittance from `grid`
+    /// ([`LightGrid::for_light_choice`]) where one light is picked.
+    pub fn with_shadows(self, grid: Option<&'a LightGrid>) -> Self {
+        Self {
+            shadows: grid,
+            ..self
+        }
+    }
+
+    /// Whether each vertex picks its light (`one`, resolved: a constant
+    /// sky, with or without a sun), which a shadow grid would serve.
+    pub fn picks_one_light(&self) -> bool {
+        self.light_sampling == LightSampling::One
+            && (self.lights.sun.is_some() || self.lights.environment.is_some())
+    }
+
+    /// Which lights the vertex at `p`, reached along `dir_in`, samples.
+    #[inline]
+    pub(super) fn light_choice(&self, phase: &Phase, p: Vec3, dir_in: Vec3) -> LightChoice {
+        match self.shadows {
+            Some(grid) if self.light_sampling == LightSampling::One => {
+                LightChoice::shadowed(&self.lights, grid, phase, p, dir_in)
+            }
+            _ => LightChoice::at(self.light_sampling, &self.lights, phase, dir_in),
         }
     }
 
@@ -229,9 +263,7 @@ impl Path {
             }
         }
     }
-}
 
-impl Path {
     /// Adds sunlight `e` (throughput included) gathered beside the path's
     /// own vertices.
     #[inline]
@@ -446,7 +478,7 @@ impl<M: Media> PathTracer<'_, M> {
             mis: !last,
             guide: light,
             index: vertex,
-            choice: LightChoice::at(self.light_sampling, &self.lights, at.phase, ray_in.dir),
+            choice: self.light_choice(at.phase, p, ray_in.dir),
             arrival: path.arrival,
         };
         let parts = self.direct_light::<S>(&v, draws, c);

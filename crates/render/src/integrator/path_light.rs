@@ -54,8 +54,11 @@ impl<M: Media> PathTracer<'_, M> {
         let (sun_picked, sky_picked) = if v.choice.is_all() {
             (true, true)
         } else {
-            let sun = draws.rng().uniform() < v.choice.sun;
-            (sun, !sun)
+            // Sun, sky, or (where the choice traces no shadow ray with the
+            // remaining probability) neither.
+            let u = draws.rng().uniform();
+            let sun = u < v.choice.sun;
+            (sun, !sun && u < v.choice.sun + v.choice.sky)
         };
         let mut l = LightParts::default();
         if let Some(sun) = self.lights.sun.as_ref().filter(|_| sun_picked) {

@@ -170,7 +170,8 @@ impl<M: Media> PathTracer<'_, M> {
     }
 
     /// The probability that a vertex whose phase function toward the sun
-    /// is `f_sun` samples the sun.
+    /// is `f_sun` samples the sun, unoccluded (an estimate: the keep
+    /// probability only needs to be the same for both strategies).
     #[inline]
     fn sun_pick(&self, f_sun: f32) -> f32 {
         let pick = LightChoice::facing_sun(self.light_sampling, &self.lights, f_sun);
@@ -241,8 +242,9 @@ impl<M: Media> PathTracer<'_, M> {
             return Vec3::ZERO;
         }
         // The continuation would reach `p` along `w` and pick the sun there
-        // with this probability.
-        let pick = self.sun_pick(it.phase.eval(w, lobe.to_sun));
+        // with this probability (its shadow grid's, as the continuation's
+        // own vertex there computes it).
+        let pick = self.light_choice(it.phase, p, w).sun;
         let weight = sunward_weight(q, f, pick);
         let s = sun.sample(rng.uniform(), rng.uniform());
         let f_sun = it.phase.eval(w, s.to_light);
