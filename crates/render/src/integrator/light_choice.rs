@@ -6,17 +6,17 @@
 //! Cycles' light tree do: the shadow rays, the larger part of a path's
 //! tracking in a cloud lit by a sun and a sky, are halved, at the price of
 //! the noise of the pick. Without a shadow grid (below) the pick follows
-//! each light's unoccluded in-scattered radiance at the vertex, `E_sun f(w_in, w_sun)` against the
-//! sky's mean radiance (the phase function integrates to 1 over the
-//! sphere), so a forward-scattering vertex facing the sun takes the sun and
-//! one facing away takes the sky; a probability is kept within
-//! [`MIN_PROBABILITY`, 1 - `MIN_PROBABILITY`] so neither light's weight
-//! exceeds `1 / MIN_PROBABILITY`.
+//! each light's unoccluded in-scattered radiance at the vertex, `E_sun
+//! f(w_in, w_sun)` against the sky's mean radiance (the phase function
+//! integrates to 1 over the sphere), so a forward-scattering vertex facing
+//! the sun takes the sun and one facing away takes the sky; a probability
+//! is kept within [`MIN_PROBABILITY`, 1 - `MIN_PROBABILITY`] so neither
+//! light's weight exceeds `1 / MIN_PROBABILITY`.
 //!
 //! Through the media: inside a thick cloud nine in ten shadow rays bring
 //! nothing back (measured on the thick benchmark cloud: the sun's and the
-//! sky's alike). So the path tracer's renders give the pick a coarse grid of each
-//! light's transmittance ([`LightGrid::for_light_choice`]): the lights are
+//! sky's alike). So a render gives the pick a coarse grid of each light's
+//! transmittance ([`LightGrid::for_light_choice`]): the lights are
 //! weighed by their in-scattered radiance seen through the media, and a
 //! vertex that expects less than [`TRACE_FRACTION`] of its unoccluded
 //! light traces a shadow ray only with probability in proportion (at least
@@ -281,8 +281,8 @@ mod tests {
         let share = luminance(seen.sun) / (luminance(seen.sun) + luminance(seen.sky));
         let share = share.clamp(MIN_PROBABILITY, 1.0 - MIN_PROBABILITY);
         assert!((lit.sun - share).abs() < 1e-5, "{lit:?} against {share}");
-        // An open sky above the face lets in more than the sun's share of
-        // it, which the unoccluded pick would have given the sun.
+        // The unoccluded pick does not see the cube, so it weighs the two
+        // lights otherwise.
         let open = LightChoice::at(LightSampling::One, &l, &phase, dir_in);
         assert!(lit.sun != open.sun, "{lit:?} {open:?}");
         let sky_only = Lights {

@@ -140,9 +140,9 @@ impl LightGrid {
     /// The coarse grid the path tracer's light choice weighs lights by
     /// (`light_choice.rs`): lattice points 8 voxels apart, at least 16
     /// along the longest axis of a small volume and at most 64 along that
-    /// of a large one (its cost bounded at any size),
-    /// marched at half that spacing, four sky directions per point. Coarse
-    /// is enough: its values only decide probabilities.
+    /// of a large one (its cost bounded at any size), marched at half that
+    /// spacing, four sky directions per point. Coarse is enough: its
+    /// values only decide probabilities.
     pub fn for_light_choice<M: Media>(medium: &M, lights: &Lights, seed: u64) -> Self {
         let voxel = medium.voxel_size();
         let voxels_across = medium.bounds().size().max_element() / voxel;

@@ -40,8 +40,8 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 /// - Next-event estimation at every scattering event: one sample of the
 ///   sun (if any) and one of the environment (if any), or of one of them
 ///   picked at random ([`LightSampling`]; weighed through the media by a
-///   shadow grid where one is given, and then sometimes none), each shadow ray's
-///   transmittance estimated by the chosen estimator. Directions from a
+///   shadow grid where one is given, and then sometimes none), each
+///   shadow ray's transmittance estimated by the chosen estimator. Directions from a
 ///   light sampler and from phase sampling are combined with the power
 ///   heuristic (Veach 1997); a delta sun gets NEE only. At the last
 ///   allowed scattering event NEE takes weight 1 and the path stops, since
