@@ -155,8 +155,8 @@ impl LightChoice {
             .environment
             .as_ref()
             .map_or(0.0, |env| luminance(env.mean_radiance()));
-        let seen = grid.in_scatter(phase, lights, p, dir_in);
-        let (sun_seen, sky_seen) = (luminance(seen.sun), luminance(seen.sky));
+        let (sun_through, sky_through) = grid.seen_fractions(phase, p, dir_in);
+        let (sun_seen, sky_seen) = (sun_open * sun_through, sky_open * sky_through);
         let trace = (sun_seen + sky_seen) / (TRACE_FRACTION * (sun_open + sky_open));
         let trace = if trace.is_finite() {
             trace.clamp(MIN_TRACE, 1.0)

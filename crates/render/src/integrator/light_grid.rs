@@ -289,6 +289,17 @@ impl LightGrid {
         out
     }
 
+    /// The fractions of the sun's and of the sky's unoccluded in-scattered
+    /// radiance that reach `p` toward a ray travelling along `dir`: the
+    /// sun's transmittance, and the sky's two bands with the phase
+    /// function's mean cosine (see [`Entry`]).
+    pub(crate) fn seen_fractions(&self, phase: &Phase, p: Vec3, dir: Vec3) -> (f32, f32) {
+        let e = self.lookup(p);
+        let b = Vec3::new(e[2], e[3], e[4]);
+        let band = e[1] + 3.0 * phase.mean_cosine() * b.dot(dir);
+        (e[0], band.max(0.0))
+    }
+
     /// Phase-weighted direct light at `p` toward a ray travelling along
     /// `dir` (pass two's in-scattering term).
     /// A map environment lights with its mean radiance here: the grid
@@ -300,16 +311,14 @@ impl LightGrid {
         p: Vec3,
         dir: Vec3,
     ) -> super::LightParts {
-        let e = self.lookup(p);
+        let (sun_seen, sky_seen) = self.seen_fractions(phase, p, dir);
         let mut s = super::LightParts::default();
         if let Some(sun) = &lights.sun {
             let f = phase.eval(dir, -sun.direction());
-            s.sun = sun.irradiance() * (f * e[0]);
+            s.sun = sun.irradiance() * (f * sun_seen);
         }
         if let Some(env) = &lights.environment {
-            let b = Vec3::new(e[2], e[3], e[4]);
-            let band = e[1] + 3.0 * phase.mean_cosine() * b.dot(dir);
-            s.sky = env.mean_radiance() * band.max(0.0);
+            s.sky = env.mean_radiance() * sky_seen;
         }
         s
     }
