@@ -21,9 +21,10 @@
 //! depend on the machine's load.
 
 use crate::camera::Camera;
-use crate::integrator::{CameraSampler, PathTracer};
+use crate::integrator::CameraSampler;
 use crate::light::Lights;
 use crate::medium::{GlobalMedia, Media};
+use crate::render::{path_tracer, ShadowGrid};
 use crate::sampling::Rng;
 use crate::scene::{MajorantMode, RenderSettings};
 use crate::stats::Counters;
@@ -76,15 +77,16 @@ impl ProbeCost {
 /// the probe's costs over the hierarchy and the global bound. Only the
 /// path tracer chooses; the marchers walk the field's own cells, which
 /// are what lets them skip empty space.
-pub fn choose<M: Media>(
+pub(crate) fn choose<M: Media>(
     media: &M,
     camera: &Camera,
     lights: &Lights,
     settings: &RenderSettings,
+    shadows: Option<&ShadowGrid>,
 ) -> (MajorantMode, Option<[ProbeCost; 2]>) {
     match settings.majorant {
         MajorantMode::Auto if settings.integrator == crate::IntegratorKind::Path => {
-            let local = probe(media, camera, lights, settings, f64::INFINITY);
+            let local = probe(media, camera, lights, settings, shadows, f64::INFINITY);
             // The global probe stops once it has cost more than the whole
             // hierarchy probe: it has lost, and a global bound far above
             // most of the density (one dense voxel in a large empty box)
@@ -96,6 +98,7 @@ pub fn choose<M: Media>(
                 camera,
                 lights,
                 settings,
+                shadows,
                 local.cost(),
             );
             let mode = if global.cost() < local.cost() {
@@ -117,18 +120,14 @@ fn probe<M: Media>(
     camera: &Camera,
     lights: &Lights,
     settings: &RenderSettings,
+    shadows: Option<&ShadowGrid>,
     limit: f64,
 ) -> ProbeCost {
-    // The render's own light sampling: one light per vertex halves the
-    // shadow rays, which shifts the balance between the structures.
-    let tracer = PathTracer::new(
-        media,
-        lights.clone(),
-        settings.transmittance,
-        settings.max_depth,
-    )
-    .with_light_sampling(settings.light_sampling)
-    .with_sunward(settings.sunward);
+    // The render's own tracer: its light choice decides how many shadow
+    // rays a path traces (one light per vertex, and through the shadow
+    // grid few deep in a thick cloud), which shifts the balance between
+    // the structures.
+    let tracer = path_tracer(media, lights, settings, shadows);
     let (w, h) = (camera.width().max(1), camera.height().max(1));
     let pixels = u64::from(w) * u64::from(h);
     // Each path has its own numbers and counts add, so the sum is the same

@@ -66,12 +66,21 @@ pub fn render<M: Media>(scene: &Scene<M>, settings: &RenderSettings) -> Rendered
         lights,
     } = scene;
     let start = Instant::now();
-    let (mode, probe) = majorant_choice::choose(media, camera, lights, settings);
+    // Built before the majorant probe, whose paths should choose their
+    // lights as the render's will (the grid holds no reference to the
+    // media, so either structure takes it).
+    let shadows = shadow_grid(media, lights, settings);
+    let (mode, probe) = majorant_choice::choose(media, camera, lights, settings, shadows.as_ref());
     let mut r = match mode {
-        MajorantMode::Global => {
-            render_with(&GlobalMedia::new(media), camera, lights, settings, start)
-        }
-        _ => render_with(media, camera, lights, settings, start),
+        MajorantMode::Global => render_with(
+            &GlobalMedia::new(media),
+            camera,
+            lights,
+            settings,
+            shadows.as_ref(),
+            start,
+        ),
+        _ => render_with(media, camera, lights, settings, shadows.as_ref(), start),
     };
     r.stats.majorant = match settings.majorant {
         MajorantMode::Auto => format!("auto: {}", mode.name()),
@@ -81,11 +90,56 @@ pub fn render<M: Media>(scene: &Scene<M>, settings: &RenderSettings) -> Rendered
     r
 }
 
+/// The path tracer `settings` ask for over `medium`, picking lights through
+/// `shadows` where it picks one per vertex: what the render traces and
+/// what the majorant probe measures.
+pub(crate) fn path_tracer<'a, M: Media>(
+    medium: &'a M,
+    lights: &Lights,
+    settings: &RenderSettings,
+    shadows: Option<&'a ShadowGrid>,
+) -> PathTracer<'a, M> {
+    PathTracer::new(
+        medium,
+        lights.clone(),
+        settings.transmittance,
+        settings.max_depth,
+    )
+    .with_light_groups(!settings.compositing.light_groups.is_empty())
+    .with_light_sampling(settings.light_sampling)
+    .with_sunward(settings.sunward)
+    .with_shadows(shadows.map(|s| &s.grid))
+}
+
+/// The light choice's shadow grid ([`LightGrid::for_light_choice`]) and
+/// the seconds it took to build.
+pub(crate) struct ShadowGrid {
+    grid: LightGrid,
+    seconds: f64,
+}
+
+/// The shadow grid a path-traced render's light choice needs, if it picks
+/// one light per vertex.
+fn shadow_grid<M: Media>(
+    media: &M,
+    lights: &Lights,
+    settings: &RenderSettings,
+) -> Option<ShadowGrid> {
+    let start = Instant::now();
+    let picks = settings.integrator == IntegratorKind::Path
+        && path_tracer(media, lights, settings, None).picks_one_light();
+    picks.then(|| ShadowGrid {
+        grid: LightGrid::for_light_choice(media, lights),
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
 fn render_with<M: Media>(
     medium: &M,
     camera: &Camera,
     lights: &Lights,
     settings: &RenderSettings,
+    shadows: Option<&ShadowGrid>,
     start: Instant,
 ) -> Rendered {
     let mut counters = Counters::default();
@@ -94,21 +148,8 @@ fn render_with<M: Media>(
     let mut light_sampling = String::new();
     let (image, aovs, layers, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
-            let tracer = PathTracer::new(
-                medium,
-                lights.clone(),
-                settings.transmittance,
-                settings.max_depth,
-            )
-            .with_light_groups(!settings.compositing.light_groups.is_empty())
-            .with_light_sampling(settings.light_sampling)
-            .with_sunward(settings.sunward);
-            let grid_start = Instant::now();
-            let shadows = tracer
-                .picks_one_light()
-                .then(|| LightGrid::for_light_choice(medium, &lights, settings.seed));
-            light_sampling = light_sampling_stat(settings, &lights, shadows.as_ref(), grid_start);
-            let tracer = tracer.with_shadows(shadows.as_ref());
+            let tracer = path_tracer(medium, &lights, settings, shadows);
+            light_sampling = light_sampling_stat(settings, &lights, shadows);
             let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
             guiding_stats = Some(stats);
             let s = tracer.with_guide(guide.as_ref());
@@ -178,8 +219,7 @@ fn render_with<M: Media>(
 fn light_sampling_stat(
     settings: &RenderSettings,
     lights: &Lights,
-    grid: Option<&LightGrid>,
-    grid_start: Instant,
+    grid: Option<&ShadowGrid>,
 ) -> String {
     let mode = match settings.light_sampling {
         LightSampling::Auto => format!(
@@ -190,8 +230,8 @@ fn light_sampling_stat(
     };
     match grid {
         Some(g) => {
-            let [x, y, z] = g.lattice();
-            let seconds = grid_start.elapsed().as_secs_f64();
+            let [x, y, z] = g.grid.lattice();
+            let seconds = g.seconds;
             format!("{mode}, through a {x}x{y}x{z} shadow grid ({seconds:.2} s)")
         }
         None => mode,

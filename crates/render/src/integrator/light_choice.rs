@@ -257,7 +257,7 @@ mod tests {
         use crate::medium::{GridField, Medium};
         let field = GridField::from_fn([32; 3], Vec3::splat(0.0625), 0.125, 4, |_, _, _| 1.0);
         let cube = crate::volumes::Volumes::from(Medium::new(field, 4.0, Vec3::splat(0.9), 0.5));
-        LightGrid::for_light_choice(&cube, lights, 7)
+        LightGrid::for_light_choice(&cube, lights)
     }
 
     /// Deep in the cube a vertex traces a shadow ray with the least
