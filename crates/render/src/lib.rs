@@ -57,6 +57,7 @@ pub mod integrator;
 pub mod light;
 pub mod majorant_choice;
 pub mod medium;
+mod path_setup;
 pub mod phase;
 pub mod ray;
 pub mod render;

@@ -24,7 +24,7 @@ use crate::camera::Camera;
 use crate::integrator::CameraSampler;
 use crate::light::Lights;
 use crate::medium::{GlobalMedia, Media};
-use crate::render::{path_tracer, ShadowGrid};
+use crate::path_setup::{path_tracer, ShadowGrid};
 use crate::sampling::Rng;
 use crate::scene::{MajorantMode, RenderSettings};
 use crate::stats::Counters;

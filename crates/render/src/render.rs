@@ -14,11 +14,12 @@ use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Image, Tile};
 use crate::guiding::{self, Frame, Guide, GuidingMode, GuidingStats, TrainingSchedule};
 use crate::integrator::{
-    CameraSampler, IntegratorKind, LightGrid, LightSampling, PathTracer, RayMarcher, TwoPassMarcher,
+    CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
 };
 use crate::light::Lights;
 use crate::majorant_choice;
 use crate::medium::{GlobalMedia, Media};
+use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGrid};
 use crate::sampling::{Draw, SampleStream, SamplerKind};
 use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 use crate::shutter::Shutter;
@@ -88,50 +89,6 @@ pub fn render<M: Media>(scene: &Scene<M>, settings: &RenderSettings) -> Rendered
     };
     r.stats.majorant_probe = probe.map(|[local, global]| [local.cost(), global.cost()]);
     r
-}
-
-/// The path tracer `settings` ask for over `medium`, picking lights through
-/// `shadows` where it picks one per vertex: what the render traces and
-/// what the majorant probe measures.
-pub(crate) fn path_tracer<'a, M: Media>(
-    medium: &'a M,
-    lights: &Lights,
-    settings: &RenderSettings,
-    shadows: Option<&'a ShadowGrid>,
-) -> PathTracer<'a, M> {
-    PathTracer::new(
-        medium,
-        lights.clone(),
-        settings.transmittance,
-        settings.max_depth,
-    )
-    .with_light_groups(!settings.compositing.light_groups.is_empty())
-    .with_light_sampling(settings.light_sampling)
-    .with_sunward(settings.sunward)
-    .with_shadows(shadows.map(|s| &s.grid))
-}
-
-/// The light choice's shadow grid ([`LightGrid::for_light_choice`]) and
-/// the seconds it took to build.
-pub(crate) struct ShadowGrid {
-    grid: LightGrid,
-    seconds: f64,
-}
-
-/// The shadow grid a path-traced render's light choice needs, if it picks
-/// one light per vertex.
-fn shadow_grid<M: Media>(
-    media: &M,
-    lights: &Lights,
-    settings: &RenderSettings,
-) -> Option<ShadowGrid> {
-    let start = Instant::now();
-    let picks = settings.integrator == IntegratorKind::Path
-        && path_tracer(media, lights, settings, None).picks_one_light();
-    picks.then(|| ShadowGrid {
-        grid: LightGrid::for_light_choice(media, lights),
-        seconds: start.elapsed().as_secs_f64(),
-    })
 }
 
 fn render_with<M: Media>(
@@ -211,30 +168,6 @@ fn render_with<M: Media>(
         aovs,
         noisy: None,
         layers,
-    }
-}
-
-/// `--stats`' light sampling: the mode (what `auto` chose), and the shadow
-/// grid the pick weighs lights by, its lattice and build time.
-fn light_sampling_stat(
-    settings: &RenderSettings,
-    lights: &Lights,
-    grid: Option<&ShadowGrid>,
-) -> String {
-    let mode = match settings.light_sampling {
-        LightSampling::Auto => format!(
-            "auto: {}",
-            LightSampling::Auto.resolve(&lights.clone().pruned()).name()
-        ),
-        mode => mode.name().into(),
-    };
-    match grid {
-        Some(g) => {
-            let [x, y, z] = g.grid.lattice();
-            let seconds = g.seconds;
-            format!("{mode}, through a {x}x{y}x{z} shadow grid ({seconds:.2} s)")
-        }
-        None => mode,
     }
 }
 
