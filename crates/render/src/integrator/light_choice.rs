@@ -16,7 +16,7 @@
 //! Through the media: inside a thick cloud nine in ten shadow rays bring
 //! nothing back (measured on the thick benchmark cloud: the sun's and the
 //! sky's alike). So a render gives the pick a coarse grid of each light's
-//! transmittance ([`LightGrid::for_light_choice`]): the lights are
+//! transmittance ([`LightGrid::for_light_choice`](super::light_grid::LightGrid::for_light_choice)): the lights are
 //! weighed by their in-scattered radiance seen through the media, and a
 //! vertex that expects less than [`TRACE_FRACTION`] of its unoccluded
 //! light traces a shadow ray only with probability in proportion (at least
@@ -40,7 +40,7 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::light_grid::LightGrid;
+use super::light_grid::Seen;
 use crate::guiding::luminance;
 use crate::light::Lights;
 use crate::phase::Phase;
@@ -136,18 +136,13 @@ impl LightChoice {
         }
     }
 
-    /// The pick at `p`, reached along `dir_in` with phase function
-    /// `phase` (`one`: a sun, a sky or both), with each light's in-scattered
-    /// radiance there as `grid` estimates it through the media; and no
-    /// light at all, with the remaining probability, where the grid
-    /// expects less than [`TRACE_FRACTION`] of the unoccluded light.
-    pub fn shadowed(
-        lights: &Lights,
-        grid: &LightGrid,
-        phase: &Phase,
-        p: Vec3,
-        dir_in: Vec3,
-    ) -> Self {
+    /// The pick at a vertex reached along `dir_in` with phase function
+    /// `phase` (`one`: a sun, a sky or both), which sees the fractions
+    /// `seen` of each light's in-scattered radiance through the media (a
+    /// shadow grid's estimate); and no light at all, with the remaining
+    /// probability, where it sees less than [`TRACE_FRACTION`] of the
+    /// unoccluded light.
+    pub fn shadowed(lights: &Lights, seen: Seen, phase: &Phase, dir_in: Vec3) -> Self {
         let sun_open = lights.sun.as_ref().map_or(0.0, |sun| {
             luminance(sun.irradiance()) * phase.eval(dir_in, -sun.direction())
         });
@@ -155,8 +150,7 @@ impl LightChoice {
             .environment
             .as_ref()
             .map_or(0.0, |env| luminance(env.mean_radiance()));
-        let (sun_through, sky_through) = grid.seen_fractions(phase, p, dir_in);
-        let (sun_seen, sky_seen) = (sun_open * sun_through, sky_open * sky_through);
+        let (sun_seen, sky_seen) = (sun_open * seen.sun, sky_open * seen.sky);
         let trace = (sun_seen + sky_seen) / (TRACE_FRACTION * (sun_open + sky_open));
         let trace = if trace.is_finite() {
             trace.clamp(MIN_TRACE, 1.0)
@@ -194,6 +188,7 @@ mod tests {
     use super::*;
     use std::sync::Arc;
 
+    use super::super::light_grid::LightGrid;
     use crate::env_map::EnvMap;
     use crate::light::{Environment, Sun};
 
@@ -270,12 +265,17 @@ mod tests {
         let grid = cube_grid(&l);
         let phase = Phase::hg(0.5);
         let dir_in = Vec3::new(0.3, 0.5, -0.2).normalize();
-        let deep = LightChoice::shadowed(&l, &grid, &phase, Vec3::splat(2.0), dir_in);
+        let deep = LightChoice::shadowed(
+            &l,
+            grid.seen(&phase, Vec3::splat(2.0), dir_in),
+            &phase,
+            dir_in,
+        );
         assert!((deep.sun + deep.sky - MIN_TRACE).abs() < 1e-6, "{deep:?}");
         assert!(deep.sun >= MIN_PROBABILITY * MIN_TRACE && deep.sky >= MIN_PROBABILITY * MIN_TRACE);
         // The sun shines down (+y is toward it): 0.05 below the top face.
         let top = Vec3::new(2.0, 3.95, 2.0);
-        let lit = LightChoice::shadowed(&l, &grid, &phase, top, dir_in);
+        let lit = LightChoice::shadowed(&l, grid.seen(&phase, top, dir_in), &phase, dir_in);
         assert!((lit.sun + lit.sky - 1.0).abs() < 1e-6, "{lit:?}");
         let seen = grid.in_scatter(&phase, &l, top, dir_in);
         let share = luminance(seen.sun) / (luminance(seen.sun) + luminance(seen.sky));
@@ -290,10 +290,15 @@ mod tests {
             ..l.clone()
         };
         let grid = cube_grid(&sky_only);
-        let deep = LightChoice::shadowed(&sky_only, &grid, &phase, Vec3::splat(2.0), dir_in);
+        let deep = LightChoice::shadowed(
+            &sky_only,
+            grid.seen(&phase, Vec3::splat(2.0), dir_in),
+            &phase,
+            dir_in,
+        );
         assert_eq!(deep.sun, 0.0);
         assert!((deep.sky - MIN_TRACE).abs() < 1e-6, "{deep:?}");
-        let edge = LightChoice::shadowed(&sky_only, &grid, &phase, top, dir_in);
+        let edge = LightChoice::shadowed(&sky_only, grid.seen(&phase, top, dir_in), &phase, dir_in);
         assert_eq!(edge.sun, 0.0);
         assert!(edge.sky > 10.0 * MIN_TRACE && edge.sky <= 1.0, "{edge:?}");
     }

@@ -29,6 +29,15 @@ const CHOICE_MAX_POINTS: f32 = 64.0;
 /// alone.
 const CHOICE_SEED: u64 = 0x5348_4144_4f57_5321;
 
+/// The fractions of the sun's and of the sky's unoccluded in-scattered
+/// radiance that reach a point through the media, as a [`LightGrid`]
+/// estimates them ([`LightGrid::seen`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Seen {
+    pub sun: f32,
+    pub sky: f32,
+}
+
 /// Resolution and quality of the two-pass light grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightGridSettings {
@@ -338,15 +347,17 @@ impl LightGrid {
         out
     }
 
-    /// The fractions of the sun's and of the sky's unoccluded in-scattered
-    /// radiance that reach `p` toward a ray travelling along `dir`: the
-    /// sun's transmittance, and the sky's two bands with the phase
+    /// What `p` sees of each light toward a ray travelling along `dir`:
+    /// the sun's transmittance, and the sky's two bands with the phase
     /// function's mean cosine (see [`Entry`]).
-    pub(crate) fn seen_fractions(&self, phase: &Phase, p: Vec3, dir: Vec3) -> (f32, f32) {
+    pub(crate) fn seen(&self, phase: &Phase, p: Vec3, dir: Vec3) -> Seen {
         let e = self.lookup(p);
         let b = Vec3::new(e[2], e[3], e[4]);
         let band = e[1] + 3.0 * phase.mean_cosine() * b.dot(dir);
-        (e[0], band.max(0.0))
+        Seen {
+            sun: e[0],
+            sky: band.max(0.0),
+        }
     }
 
     /// Phase-weighted direct light at `p` toward a ray travelling along
@@ -360,14 +371,14 @@ impl LightGrid {
         p: Vec3,
         dir: Vec3,
     ) -> super::LightParts {
-        let (sun_seen, sky_seen) = self.seen_fractions(phase, p, dir);
+        let seen = self.seen(phase, p, dir);
         let mut s = super::LightParts::default();
         if let Some(sun) = &lights.sun {
             let f = phase.eval(dir, -sun.direction());
-            s.sun = sun.irradiance() * (f * sun_seen);
+            s.sun = sun.irradiance() * (f * seen.sun);
         }
         if let Some(env) = &lights.environment {
-            s.sky = env.mean_radiance() * sky_seen;
+            s.sky = env.mean_radiance() * seen.sky;
         }
         s
     }

@@ -5,7 +5,7 @@
 use glam::Vec3;
 
 use super::light_choice::{LightChoice, LightSampling};
-use super::light_grid::LightGrid;
+use super::light_grid::{LightGrid, Seen};
 use super::path_light::Vertex;
 use super::path_split::{At, Pending};
 use super::path_sunward::{Arrival, Sunward};
@@ -142,12 +142,25 @@ impl<'a, M: Media> PathTracer<'a, M> {
             && (self.lights.sun.is_some() || self.lights.environment.is_some())
     }
 
-    /// Which lights the vertex at `p`, reached along `dir_in`, samples.
+    /// What the vertex at `p`, reached along `dir_in`, sees of each light
+    /// through the media, where a shadow grid is given.
     #[inline]
-    pub(super) fn light_choice(&self, phase: &Phase, p: Vec3, dir_in: Vec3) -> LightChoice {
-        match self.shadows {
-            Some(grid) if self.light_sampling == LightSampling::One => {
-                LightChoice::shadowed(&self.lights, grid, phase, p, dir_in)
+    pub(super) fn seen(&self, phase: &Phase, p: Vec3, dir_in: Vec3) -> Option<Seen> {
+        self.shadows.map(|grid| grid.seen(phase, p, dir_in))
+    }
+
+    /// Which lights a vertex reached along `dir_in`, which sees `seen`
+    /// ([`Self::seen`]), samples.
+    #[inline]
+    pub(super) fn light_choice(
+        &self,
+        phase: &Phase,
+        dir_in: Vec3,
+        seen: Option<Seen>,
+    ) -> LightChoice {
+        match seen {
+            Some(seen) if self.light_sampling == LightSampling::One => {
+                LightChoice::shadowed(&self.lights, seen, phase, dir_in)
             }
             _ => LightChoice::at(self.light_sampling, &self.lights, phase, dir_in),
         }
@@ -471,6 +484,7 @@ impl<M: Media> PathTracer<'_, M> {
             .and_then(|(g, site)| g.light(site))
             .and_then(|l| l.product(|d| at.phase.eval(ray_in.dir, d)));
         let light = product.as_ref();
+        let seen = self.seen(at.phase, p, ray_in.dir);
         let v = Vertex {
             p,
             ray_in: &ray_in,
@@ -478,7 +492,7 @@ impl<M: Media> PathTracer<'_, M> {
             mis: !last,
             guide: light,
             index: vertex,
-            choice: self.light_choice(at.phase, p, ray_in.dir),
+            choice: self.light_choice(at.phase, ray_in.dir, seen),
             arrival: path.arrival,
         };
         let parts = self.direct_light::<S>(&v, draws, c);
@@ -496,7 +510,7 @@ impl<M: Media> PathTracer<'_, M> {
         // The sunward strategy gathers the next vertex's sunlight beside
         // the continuation (`path_sunward.rs`).
         let guided_directions = guide.is_some_and(|g| g.decisions().directions);
-        let lobe = self.sunward_lobe(path, at, ray_in.dir, guided_directions);
+        let lobe = self.sunward_lobe(path, at, ray_in.dir, guided_directions, seen);
         if let Some(lobe) = &lobe {
             let e = self.sunward::<S>(path, at, lobe, &ray_in, draws, c);
             path.add_sun(e, self.light_groups, learner);
