@@ -53,18 +53,16 @@ pub(crate) fn shadow_grid<M: Media>(
     })
 }
 
-/// `--stats`' light sampling: the mode (what `auto` chose), and the shadow
-/// grid the pick weighs lights by, its lattice and build time.
-pub(crate) fn light_sampling_stat(
+/// `--stats`' light sampling: the mode (what `auto` chose for `tracer`),
+/// and the shadow grid the pick weighs lights by, its lattice and build
+/// time.
+pub(crate) fn light_sampling_stat<M: Media>(
     settings: &RenderSettings,
-    lights: &Lights,
+    tracer: &PathTracer<M>,
     grid: Option<&ShadowGrid>,
 ) -> String {
     let mode = match settings.light_sampling {
-        LightSampling::Auto => format!(
-            "auto: {}",
-            LightSampling::Auto.resolve(&lights.clone().pruned()).name()
-        ),
+        LightSampling::Auto => format!("auto: {}", tracer.light_sampling().name()),
         mode => mode.name().into(),
     };
     match grid {

@@ -106,7 +106,7 @@ fn render_with<M: Media>(
     let (image, aovs, layers, setup_seconds) = match settings.integrator {
         IntegratorKind::Path => {
             let tracer = path_tracer(medium, &lights, settings, shadows);
-            light_sampling = light_sampling_stat(settings, &lights, shadows);
+            light_sampling = light_sampling_stat(settings, &tracer, shadows);
             let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
             guiding_stats = Some(stats);
             let s = tracer.with_guide(guide.as_ref());

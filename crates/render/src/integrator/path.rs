@@ -135,6 +135,12 @@ impl<'a, M: Media> PathTracer<'a, M> {
         }
     }
 
+    /// How many lights each vertex samples, `auto` resolved for this
+    /// tracer's lights.
+    pub fn light_sampling(&self) -> LightSampling {
+        self.light_sampling
+    }
+
     /// Whether each vertex picks its light (`one`, resolved: a constant
     /// sky, with or without a sun), which a shadow grid would serve.
     pub fn picks_one_light(&self) -> bool {
