@@ -14,8 +14,9 @@
 //! adaptive sampling, guiding, light selection and denoising each give:
 //! independent random numbers instead of Sobol points, adaptive sampling
 //! at `--noise-threshold`, path guiding (`--guiding on`, roulette and
-//! splitting, and `--guiding directions`, guided directions as well; their
-//! training counted in the time), a shadow ray to every light at each vertex
+//! splitting, `--guiding directions`, guided directions as well, and
+//! `--guiding distances`, guided collisions too; their training counted in
+//! the time), a shadow ray to every light at each vertex
 //! (`--light-sampling all`) instead of to one, sunward scattering
 //! (`--sunward on`; every other row renders with it off, so that the
 //! estimators compare as Mitsuba and Cycles trace),
@@ -185,6 +186,10 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
     v.push(Config {
         guiding: GuidingMode::Directions,
         ..default("guided directions")
+    });
+    v.push(Config {
+        guiding: GuidingMode::Distances,
+        ..default("guided distances")
     });
     v.push(Config {
         sunward: Sunward::On,

@@ -536,6 +536,15 @@ fn trained_guide<'m, M: Media>(
         },
     );
     stats.mode = mode;
+    let mut guide = guide;
+    // The phase function at the media's centre stands for all of them
+    // (one medium is the common case; a different phase elsewhere makes
+    // the guided distances' estimate worse, never biased).
+    let centre = media.bounds().centre();
+    let phase = media
+        .interaction(centre, 0.0, &mut crate::sampling::Rng::new(0, 0, 0))
+        .phase;
+    guide.scatter_light(phase);
     (Some(guide), stats)
 }
 

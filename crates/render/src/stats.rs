@@ -49,6 +49,9 @@ pub struct Counters {
     /// (`integrator/path_sunward.rs`), each a free flight and, where it
     /// collides, a shadow ray.
     pub sunward_rays: u64,
+    /// Tentative collisions made real or null by the learned estimate of
+    /// what each brings (`tracking/guided.rs`), not by the density alone.
+    pub guided_collisions: u64,
 }
 
 impl AddAssign for Counters {
@@ -70,6 +73,7 @@ impl AddAssign for Counters {
         self.split_copies += o.split_copies;
         self.roulette_ends += o.roulette_ends;
         self.sunward_rays += o.sunward_rays;
+        self.guided_collisions += o.guided_collisions;
     }
 }
 

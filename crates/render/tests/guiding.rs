@@ -1,6 +1,6 @@
-//! Guided path tracing stays exact and reproducible, in both guided modes
+//! Guided path tracing stays exact and reproducible, in every guided mode
 //! (`on`: roulette and splitting; `directions`: resampled directions as
-//! well):
+//! well; `distances`: and collisions decided by the learned light too):
 //! - a guided render is the same, bit for bit, on one thread and two, and
 //!   a crop of it is the full render's pixels (training covers the whole
 //!   frame on a fixed schedule);
@@ -32,7 +32,11 @@ fn sunlit_cloud(
     )
 }
 
-const GUIDED: [GuidingMode; 2] = [GuidingMode::On, GuidingMode::Directions];
+const GUIDED: [GuidingMode; 3] = [
+    GuidingMode::On,
+    GuidingMode::Directions,
+    GuidingMode::Distances,
+];
 
 #[test]
 fn guided_renders_are_the_same_on_any_thread_count_and_in_crops() {
@@ -147,7 +151,17 @@ fn guided_and_unguided_renders_agree_under_sun_and_sky() {
         s.seed = seed;
         s.guiding = mode;
         let guided = render(&scene, &s);
-        assert!(guided.stats.counters.split_copies > 0, "{mode:?}");
+        let c = &guided.stats.counters;
+        assert!(c.split_copies > 0, "{mode:?}");
+        // Where distances are guided, most tentative collisions are
+        // decided by the learned light (the rest lie where the cache has
+        // not learned); elsewhere none are.
+        let guided_share =
+            c.guided_collisions as f64 / (c.real_collisions + c.null_collisions) as f64;
+        match mode {
+            GuidingMode::Distances => assert!(guided_share > 0.5, "{mode:?}: {c:?}"),
+            _ => assert_eq!(c.guided_collisions, 0, "{mode:?}"),
+        }
         assert_pooled_bias(&format!("{mode:?} under sun and sky"), &guided, &unguided);
     }
 }

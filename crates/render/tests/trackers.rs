@@ -4,8 +4,8 @@
 mod common;
 
 use cirrus_render::tracking::{
-    ratio_tracking, residual_ratio_tracking, sample_free_flight, track_length_transmittance,
-    transmittance, FreeFlight, TransmittanceEstimator,
+    ratio_tracking, residual_ratio_tracking, sample_free_flight, sample_guided_free_flight,
+    track_length_transmittance, transmittance, FreeFlight, TransmittanceEstimator,
 };
 use cirrus_render::Bounds3;
 use cirrus_render::{
@@ -200,4 +200,82 @@ fn track_length_and_ratio_agree_through_the_public_functions() {
         track_length_transmittance::<f32, _>(&medium, &chord_ray(), 9.0, rng, &mut c)
     });
     assert!((a - b).abs() <= 5.0 * (se_a * se_a + se_b * se_b).sqrt());
+}
+
+/// `integral of sigma_t(t) T(t) f(t) dt` over the ray's overlap with the
+/// field, by midpoint quadrature in f64: the expectation of `f` at a free
+/// flight's collision.
+fn quadrature_collision_mean<M: Media>(medium: &M, ray: &Ray, f: impl Fn(f32) -> f64) -> f64 {
+    let Bounds3 { min: lo, max: hi } = medium.bounds();
+    let (t0, t1) = Bounds3::new(lo, hi)
+        .clip_ray(ray.origin, ray.dir, 0.0, f32::INFINITY)
+        .expect("the ray crosses the field");
+    let n = 20_000;
+    let h = (t1 - t0) as f64 / n as f64;
+    let (mut tau, mut sum) = (0f64, 0f64);
+    for i in 0..n {
+        let t = (t0 as f64 + (i as f64 + 0.5) * h) as f32;
+        let sigma = medium.extinction::<f32>(ray.at(t), 0.0) as f64;
+        // Transmittance to the step's midpoint.
+        let mid = tau + 0.5 * sigma * h;
+        sum += sigma * (-mid).exp() * f(t) * h;
+        tau += sigma * h;
+    }
+    sum
+}
+
+#[test]
+fn guided_flights_keep_the_analog_flights_expectations() {
+    // Through a heterogeneous field under its global majorant (null
+    // collisions at most tentative points), with a worth that varies by
+    // orders of magnitude along the ray: the weighted escape estimates the
+    // transmittance, and the weighted collision point the analog flight's
+    // collision density.
+    let field = common::cloud_field(4);
+    let Bounds3 { min: lo, max: hi } = field.bounds();
+    let centre = 0.5 * (lo + hi);
+    let medium = Volumes::from(Medium::new(field, 6.0, Vec3::ONE, 0.0));
+    let global = GlobalMedia::new(&medium);
+    let ray = Ray::new(
+        centre - Vec3::new(2.0, 0.3, 0.1),
+        Vec3::new(1.0, 0.15, 0.05).normalize(),
+    );
+    let worth = |p: Vec3| Some(10.0 * (4.0 * (p.x - centre.x)).exp());
+    let exact_t = quadrature_transmittance(&medium, &ray);
+    let exact_at = quadrature_collision_mean(&medium, &ray, |t| t as f64);
+    let mut c = Counters::default();
+    let mut flight = |rng: &mut Rng, weighted: bool| {
+        let mut beta = Vec3::ONE;
+        let f =
+            sample_guided_free_flight(&global, &ray, f32::INFINITY, &mut beta, rng, &mut c, worth);
+        let w = if weighted { beta.x } else { 1.0 };
+        (f, w)
+    };
+    let (escape, se_e) = estimate(40_000, 30, |rng| match flight(rng, true) {
+        (FreeFlight::Escaped, w) => w,
+        _ => 0.0,
+    });
+    let (at, se_at) = estimate(40_000, 31, |rng| match flight(rng, true) {
+        (FreeFlight::Collision { t }, w) => w * t,
+        _ => 0.0,
+    });
+    assert!(
+        (escape - exact_t).abs() <= 5.0 * se_e,
+        "escape {escape} vs T {exact_t} (se {se_e})"
+    );
+    assert!(
+        (at - exact_at).abs() <= 5.0 * se_at,
+        "collision mean {at} vs {exact_at} (se {se_at})"
+    );
+    // The same flights without their branch weights are another
+    // distribution: the test can tell.
+    let (unweighted, se_u) = estimate(40_000, 32, |rng| match flight(rng, false) {
+        (FreeFlight::Escaped, w) => w,
+        _ => 0.0,
+    });
+    assert!(
+        (unweighted - exact_t).abs() > 5.0 * se_u,
+        "unweighted escape {unweighted} vs T {exact_t} (se {se_u})"
+    );
+    assert!(c.null_collisions > c.real_collisions / 4, "{c:?}");
 }

@@ -95,7 +95,8 @@ declare_settings! {
     /// Path guiding: learn where the light comes from (a radiance cache
     /// trained on the frame's own paths); `on` plays roulette with paths
     /// headed for the dark and splits those reaching the light,
-    /// `directions` also scatters toward the learned light; `auto` guides
+    /// `directions` also scatters toward the learned light, `distances`
+    /// also decides collisions by the learned light ahead; `auto` guides
     /// where that pays, which measured is nowhere yet.
     guiding: GuidingMode, flag(long, value_enum), default(GuidingMode::Auto),
         example(GuidingMode::On);

@@ -14,7 +14,7 @@
 //! - `grid`: the in-scattered radiance on a pyramid of regular grids,
 //!   finer than the regions, for roulette and splitting.
 //!
-//! A [`Guide`] is the cache frozen for a pass. It guides two decisions
+//! A [`Guide`] is the cache frozen for a pass. It guides three decisions
 //! ([`Decisions`]), each unbiased for any cache:
 //! - roulette and splitting (`integrator/path_split.rs`, Vorba and
 //!   Křivánek 2016): a path whose expected contribution, its throughput
@@ -25,10 +25,15 @@
 //!   the phase function and the product of the phase function with the
 //!   learned incident light (Herholz et al. 2019, "Volume Path Guiding
 //!   Based on Zero-Variance Random Walk Theory", section 4), its density
-//!   exact.
+//!   exact;
+//! - distances (`tracking/guided.rs`): whether a tentative collision is
+//!   real or null, weighed by the learned in-scattered radiance at it
+//!   against the learned light arriving along the ray from beyond it
+//!   (the same paper's section 5, in null-collision form).
 //!
-//! Measured on a thick, bright cloud (BENCHMARKS.md, "Guided path
-//! tracing") neither pays yet at equal time, so `auto` renders unguided.
+//! Measured on a thick, bright cloud and a thin sky-lit one (BENCHMARKS.md,
+//! "Guided path tracing", "Guided distances") none pays yet at equal time,
+//! so `auto` renders unguided.
 
 mod grid;
 mod learn;
@@ -40,12 +45,15 @@ pub use grid::InscatteredGrid;
 pub use learn::{luminance, Ignore, Learner, PathRecorder};
 pub use regions::{Record, Region, Regions, MAX_REGIONS};
 pub use sphere::{bin_centres, BinDistribution, IncidentLight, BINS};
+
+use sphere::bin_of;
 pub use training::{train, Frame, TrainingSchedule};
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use crate::medium::Bounds3;
+use crate::phase::Phase;
 
 /// Whether the path tracer learns and follows a radiance cache, and which
 /// decisions it guides ([`Decisions`]).
@@ -64,6 +72,10 @@ pub enum GuidingMode {
     /// As `on`, and scattered directions resampled toward the learned
     /// incident light.
     Directions,
+    /// As `directions`, and free flights' collisions guided by the learned
+    /// in-scattered light. Chromatic media keep spectral tracking's
+    /// unguided flights.
+    Distances,
     Off,
 }
 
@@ -73,6 +85,7 @@ impl GuidingMode {
             Self::Auto => "auto",
             Self::On => "on",
             Self::Directions => "directions",
+            Self::Distances => "distances",
             Self::Off => "off",
         }
     }
@@ -85,10 +98,17 @@ impl GuidingMode {
             Self::On => Some(Decisions {
                 directions: false,
                 roulette: true,
+                distances: false,
             }),
             Self::Directions => Some(Decisions {
                 directions: true,
                 roulette: true,
+                distances: false,
+            }),
+            Self::Distances => Some(Decisions {
+                directions: true,
+                roulette: true,
+                distances: true,
             }),
         }
     }
@@ -109,6 +129,9 @@ pub struct Decisions {
     /// Russian roulette and splitting against the learned in-scattered
     /// radiance (Vorba and Křivánek 2016).
     pub roulette: bool,
+    /// Tentative collisions made real or null in proportion to what each
+    /// choice is expected to bring (Herholz et al. 2019, section 5).
+    pub distances: bool,
 }
 
 /// The radiance cache, frozen: what a pass's paths are guided by.
@@ -117,6 +140,10 @@ pub struct Guide {
     regions: Regions,
     grid: InscatteredGrid,
     decisions: Decisions,
+    /// Per region, its learned light scattered toward each direction bin
+    /// ([`IncidentLight::scattered`]), for guided distances; empty until
+    /// [`Guide::scatter_light`].
+    scattered: Vec<Option<[f32; BINS]>>,
 }
 
 impl Guide {
@@ -127,6 +154,7 @@ impl Guide {
             regions: Regions::new(bounds),
             grid: InscatteredGrid::new(bounds),
             decisions,
+            scattered: Vec::new(),
         }
     }
 
@@ -163,6 +191,33 @@ impl Guide {
             .mean(site.cell)
             .unwrap_or_else(|| self.regions.region(site.region).inscattered());
         (l > 0.0).then_some(l)
+    }
+
+    /// Readies guided distances once learning is over: each region's
+    /// learned light scattered by `phase` toward every direction bin.
+    pub fn scatter_light(&mut self, phase: &Phase) {
+        if !self.decisions.distances {
+            return;
+        }
+        self.scattered = (0..self.regions.len() as u32)
+            .map(|r| self.regions.region(r).light().map(|l| l.scattered(phase)))
+            .collect();
+    }
+
+    /// What a tentative collision at `p` on a ray along `dir` is expected
+    /// to bring if real, over what it brings if null: the learned light
+    /// there scattered back along the ray, over the learned light arriving
+    /// from `dir` (the light beyond the collision that a null collision
+    /// goes on to gather). `None` where the guide does not guide
+    /// distances or has not learned there.
+    #[inline]
+    pub fn collision_worth(&self, p: Vec3, dir: Vec3) -> Option<f32> {
+        let r = self.regions.index_of(p);
+        let scattered = self.scattered.get(r as usize)?.as_ref()?;
+        let light = self.regions.region(r).light()?;
+        let bin = bin_of(dir);
+        let worth = scattered[bin] / light.bins()[bin];
+        (worth.is_finite() && worth > 0.0).then_some(worth)
     }
 
     pub fn decisions(&self) -> Decisions {

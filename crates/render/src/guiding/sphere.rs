@@ -15,6 +15,8 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use crate::phase::Phase;
+
 /// Bins along `z = cos(theta)`.
 pub const Z_BINS: usize = 8;
 /// Bins along the azimuth.
@@ -94,6 +96,29 @@ impl IncidentLight {
     #[inline]
     pub fn radiance(&self, dir: Vec3) -> f32 {
         self.radiance[bin_of(dir)]
+    }
+
+    /// The learned light scattered once by `phase` toward each bin's
+    /// centre: entry `o` is the mean of the bins' radiance weighted by
+    /// `phase.eval(c_o, c_b)`, the in-scattered radiance a path arriving
+    /// along bin `o`'s centre finds (normalised by the weights' sum, so
+    /// uniform light scatters to itself whatever the bins resolve of the
+    /// phase function's peak).
+    pub fn scattered(&self, phase: &Phase) -> [f32; BINS] {
+        let centres = bin_centres();
+        std::array::from_fn(|o| {
+            let (mut sum, mut weights) = (0.0f32, 0.0f32);
+            for (c, &l) in centres.iter().zip(&self.radiance) {
+                let f = phase.eval(centres[o], *c);
+                sum += f * l;
+                weights += f;
+            }
+            if weights > 0.0 {
+                sum / weights
+            } else {
+                0.0
+            }
+        })
     }
 
     /// The learned light alone as a density to sample.

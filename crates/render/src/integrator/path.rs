@@ -19,7 +19,9 @@ use crate::ray::Ray;
 use crate::sampling::{Draw, Rng, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::stats::Counters;
-use crate::tracking::{sample_free_flight, FreeFlight, TransmittanceEstimator};
+use crate::tracking::{
+    sample_free_flight, sample_guided_free_flight, FreeFlight, TransmittanceEstimator,
+};
 
 /// Russian roulette on path throughput starts after this many scattering
 /// events...
@@ -365,18 +367,34 @@ impl<M: Media> PathTracer<'_, M> {
                     // path vertex `path.depth` of the draw allocation.
                     let vertex = path.depth;
                     let ray = path.ray;
-                    let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
-                        sample_free_flight::<S, M>(
+                    // Spectral tracking's flights stay unguided.
+                    let guided = guide.filter(|g| g.decisions().distances && !S::CHROMATIC);
+                    let flight = draws.leading(Draw::FreeFlight, vertex, |rng| match guided {
+                        Some(g) => sample_guided_free_flight(
                             self.medium,
                             &ray,
                             ray.t_max,
                             &mut path.beta,
                             rng,
                             c,
-                        )
+                            |p| g.collision_worth(p, ray.dir),
+                        ),
+                        None => sample_free_flight::<S, M>(
+                            self.medium,
+                            &ray,
+                            ray.t_max,
+                            &mut path.beta,
+                            rng,
+                            c,
+                        ),
                     });
                     if path.depth == 0 {
                         path.out.alpha = match flight {
+                            // A guided escape's weight estimates the
+                            // transmittance, as spectral tracking's does.
+                            FreeFlight::Escaped if guided.is_some() => {
+                                Vec3::escaped_alpha(path.beta)
+                            }
                             FreeFlight::Escaped => S::escaped_alpha(path.beta),
                             _ => 1.0,
                         };
