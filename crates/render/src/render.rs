@@ -20,7 +20,7 @@ use crate::light::Lights;
 use crate::majorant_choice;
 use crate::medium::{GlobalMedia, Media};
 use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGrid};
-use crate::sampling::{Draw, SampleStream, SamplerKind};
+use crate::sampling::{Draw, Rng, SampleStream, SamplerKind};
 use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 use crate::shutter::Shutter;
 use crate::stats::{Counters, RenderStats};
@@ -100,55 +100,29 @@ fn render_with<M: Media>(
     start: Instant,
 ) -> Rendered {
     let mut counters = Counters::default();
-    let mut guiding_stats = None;
-    let lights = lights.clone();
-    let mut light_sampling = String::new();
-    let (image, aovs, layers, setup_seconds) = match settings.integrator {
-        IntegratorKind::Path => {
-            let tracer = path_tracer(medium, &lights, settings, shadows);
-            light_sampling = light_sampling_stat(settings, &tracer, shadows);
-            let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
-            guiding_stats = Some(stats);
-            let s = tracer.with_guide(guide.as_ref());
-            let setup = start.elapsed().as_secs_f64();
-            let (image, aovs, layers) = run(&s, camera, settings, start, &mut counters);
-            (image, aovs, layers, setup)
-        }
-        IntegratorKind::RayMarch => {
-            let s = RayMarcher::new(medium, lights, settings.step_voxels)
-                .with_shadow_step(settings.shadow_step());
-            let (image, aovs, layers) = run(&s, camera, settings, start, &mut counters);
-            (image, aovs, layers, 0.0)
-        }
-        IntegratorKind::RayMarch2Pass => {
-            let grid = LightGrid::build(
-                medium,
-                &lights,
-                settings.shadow_step(),
-                &settings.light_grid,
-                settings.seed,
-                &mut counters,
-            );
-            let setup = start.elapsed().as_secs_f64();
-            let s = TwoPassMarcher::new(medium, lights, &grid, settings.step_voxels);
-            let (image, aovs, layers) = run(&s, camera, settings, start, &mut counters);
-            (image, aovs, layers, setup)
-        }
-    };
+    let out = integrate(
+        medium,
+        camera,
+        lights,
+        settings,
+        shadows,
+        start,
+        &mut counters,
+    );
     let wall_seconds = start.elapsed().as_secs_f64();
     let stats = RenderStats {
         integrator: settings.integrator.name().into(),
         transmittance: settings.transmittance.name().into(),
         majorant: settings.majorant.name().into(),
-        width: image.width,
-        height: image.height,
-        spp: image.spp,
+        width: out.image.width,
+        height: out.image.height,
+        spp: out.image.spp,
         wall_seconds,
-        setup_seconds,
+        setup_seconds: out.setup_seconds,
         counters,
         rays_per_second: counters.paths as f64 / wall_seconds.max(1e-9),
-        guiding: guiding_stats,
-        light_sampling,
+        guiding: out.guiding,
+        light_sampling: out.light_sampling,
         sunward: match settings.integrator {
             IntegratorKind::Path => settings.sunward.name().into(),
             _ => String::new(),
@@ -157,7 +131,7 @@ fn render_with<M: Media>(
     };
     let crop = crop_of(settings, camera);
     Rendered {
-        image,
+        image: out.image,
         stats,
         window: Window {
             x0: crop.x0,
@@ -165,9 +139,77 @@ fn render_with<M: Media>(
             full_width: camera.width(),
             full_height: camera.height(),
         },
-        aovs,
+        aovs: out.aovs,
         noisy: None,
+        layers: out.layers,
+    }
+}
+
+/// The image, AOVs and layers the sample passes resolve to.
+type Resolved = (Image, Option<AovImage>, Option<Layers>);
+
+/// What the integrator's passes made, with what its setup reports.
+struct Integrated {
+    image: Image,
+    aovs: Option<AovImage>,
+    layers: Option<Layers>,
+    /// Seconds from the render's start to its first sample pass (shadow
+    /// grids, guide training).
+    setup_seconds: f64,
+    guiding: Option<GuidingStats>,
+    light_sampling: String,
+}
+
+/// Sets up the chosen integrator over `medium` and runs its passes.
+fn integrate<M: Media>(
+    medium: &M,
+    camera: &Camera,
+    lights: &Lights,
+    settings: &RenderSettings,
+    shadows: Option<&ShadowGrid>,
+    start: Instant,
+    counters: &mut Counters,
+) -> Integrated {
+    let lights = lights.clone();
+    let done = |(image, aovs, layers): Resolved, setup_seconds: f64| Integrated {
+        image,
+        aovs,
         layers,
+        setup_seconds,
+        guiding: None,
+        light_sampling: String::new(),
+    };
+    match settings.integrator {
+        IntegratorKind::Path => {
+            let tracer = path_tracer(medium, &lights, settings, shadows);
+            let light_sampling = light_sampling_stat(settings, &tracer, shadows);
+            let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
+            let s = tracer.with_guide(guide.as_ref());
+            let setup = start.elapsed().as_secs_f64();
+            Integrated {
+                guiding: Some(stats),
+                light_sampling,
+                ..done(run(&s, camera, settings, start, counters), setup)
+            }
+        }
+        IntegratorKind::RayMarch => {
+            let s = RayMarcher::new(medium, lights, settings.step_voxels)
+                .with_shadow_step(settings.shadow_step());
+            done(run(&s, camera, settings, start, counters), 0.0)
+        }
+        IntegratorKind::RayMarch2Pass => {
+            let grid = LightGrid::build(
+                medium,
+                &lights,
+                settings.shadow_step(),
+                &settings.light_grid,
+                settings.seed,
+                counters,
+            );
+            let setup = start.elapsed().as_secs_f64();
+            let s = TwoPassMarcher::new(medium, lights, &grid, settings.step_voxels);
+            done(run(&s, camera, settings, start, counters), setup)
+        }
     }
 }
 
@@ -201,7 +243,7 @@ fn run<S: CameraSampler>(
     settings: &RenderSettings,
     start: Instant,
     counters: &mut Counters,
-) -> (Image, Option<AovImage>, Option<Layers>) {
+) -> Resolved {
     let crop = crop_of(settings, camera);
     let mut film = Film::new(
         (crop.x0, crop.y0, crop.x1 - crop.x0, crop.y1 - crop.y0),
@@ -526,7 +568,7 @@ fn trained_guide<'m, M: Media>(
         Budget::Spp(n) => n,
         Budget::Time(_) => TIMED_TRAINING_SPP,
     };
-    let (guide, mut stats, _) = guiding::train(
+    let (mut guide, mut stats, _) = guiding::train(
         media.bounds(),
         decisions,
         &frame,
@@ -536,14 +578,11 @@ fn trained_guide<'m, M: Media>(
         },
     );
     stats.mode = mode;
-    let mut guide = guide;
     // The phase function at the media's centre stands for all of them
     // (one medium is the common case; a different phase elsewhere makes
     // the guided distances' estimate worse, never biased).
     let centre = media.bounds().centre();
-    let phase = media
-        .interaction(centre, 0.0, &mut crate::sampling::Rng::new(0, 0, 0))
-        .phase;
+    let phase = media.interaction(centre, 0.0, &mut Rng::new(0, 0, 0)).phase;
     guide.scatter_light(phase);
     (Some(guide), stats)
 }
