@@ -140,10 +140,12 @@ pub struct Guide {
     regions: Regions,
     grid: InscatteredGrid,
     decisions: Decisions,
-    /// Per region, its learned light scattered toward each direction bin
-    /// ([`IncidentLight::scattered`]), for guided distances; empty until
+    /// Per region and direction bin, what a tentative collision on a ray
+    /// along the bin is worth real over null (see
+    /// [`Guide::collision_worth_along`]), 0 where there is no estimate;
+    /// `None` where the region learned no light, and empty until
     /// [`Guide::scatter_light`].
-    scattered: Vec<Option<[f32; BINS]>>,
+    worth: Vec<Option<[f32; BINS]>>,
 }
 
 impl Guide {
@@ -154,7 +156,7 @@ impl Guide {
             regions: Regions::new(bounds),
             grid: InscatteredGrid::new(bounds),
             decisions,
-            scattered: Vec::new(),
+            worth: Vec::new(),
         }
     }
 
@@ -193,31 +195,47 @@ impl Guide {
         (l > 0.0).then_some(l)
     }
 
-    /// Readies guided distances once learning is over: each region's
-    /// learned light scattered by `phase` toward every direction bin.
+    /// Readies guided distances once learning is over: for each region
+    /// and direction bin, its learned light scattered by `phase` back
+    /// along a ray in that bin ([`IncidentLight::scattered`]), over its
+    /// learned light arriving from that bin (the light beyond a collision
+    /// that a null collision goes on to gather).
     pub fn scatter_light(&mut self, phase: &Phase) {
         if !self.decisions.distances {
             return;
         }
-        self.scattered = (0..self.regions.len() as u32)
-            .map(|r| self.regions.region(r).light().map(|l| l.scattered(phase)))
+        self.worth = (0..self.regions.len() as u32)
+            .map(|r| {
+                let light = self.regions.region(r).light()?;
+                let scattered = light.scattered(phase);
+                Some(std::array::from_fn(|b| {
+                    let worth = scattered[b] / light.bins()[b];
+                    if worth.is_finite() && worth > 0.0 {
+                        worth
+                    } else {
+                        0.0
+                    }
+                }))
+            })
             .collect();
     }
 
-    /// What a tentative collision at `p` on a ray along `dir` is expected
-    /// to bring if real, over what it brings if null: the learned light
-    /// there scattered back along the ray, over the learned light arriving
-    /// from `dir` (the light beyond the collision that a null collision
-    /// goes on to gather). `None` where the guide does not guide
-    /// distances or has not learned there.
+    /// What a tentative collision at a point on a ray along `dir` is
+    /// expected to bring if real, over what it brings if null, as a
+    /// function of the point (the direction's bin found once per flight).
+    /// It gives `None` where the guide does not guide distances or has not
+    /// learned there.
     #[inline]
-    pub fn collision_worth(&self, p: Vec3, dir: Vec3) -> Option<f32> {
-        let r = self.regions.index_of(p);
-        let scattered = self.scattered.get(r as usize)?.as_ref()?;
-        let light = self.regions.region(r).light()?;
+    pub fn collision_worth_along(&self, dir: Vec3) -> impl Fn(Vec3) -> Option<f32> + '_ {
         let bin = bin_of(dir);
-        let worth = scattered[bin] / light.bins()[bin];
-        (worth.is_finite() && worth > 0.0).then_some(worth)
+        move |p| {
+            let table = self
+                .worth
+                .get(self.regions.index_of(p) as usize)?
+                .as_ref()?;
+            let worth = table[bin];
+            (worth > 0.0).then_some(worth)
+        }
     }
 
     pub fn decisions(&self) -> Decisions {

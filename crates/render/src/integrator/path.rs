@@ -377,7 +377,7 @@ impl<M: Media> PathTracer<'_, M> {
                             &mut path.beta,
                             rng,
                             c,
-                            |p| g.collision_worth(p, ray.dir),
+                            g.collision_worth_along(ray.dir),
                         ),
                         None => sample_free_flight::<S, M>(
                             self.medium,
