@@ -1,6 +1,12 @@
 //! Deep scanline OpenEXR 2 images, written and read through OpenEXR's own
-//! C library (OpenEXRCore, Debian's `libopenexr-dev`), for the renderer's
-//! deep output and the merge of deep crop tiles.
+//! C library (OpenEXRCore 3.1 or newer), for the renderer's deep output and
+//! the merge of deep crop tiles.
+//!
+//! The library is loaded at run time, the first time a deep image is
+//! written or read (`$CIRRUS_OPENEXR_CORE`, else the loader's usual path:
+//! Debian's `libopenexr-3-1-30`), so building cirrus and rendering flat
+//! images need no system library; asking for a deep image without it is an
+//! error that says what to install.
 //!
 //! The files are single-part, deep scanline, uncompressed, with 32-bit
 //! float channels. Uncompressed because OpenEXRCore 3.1 writes deep
@@ -108,24 +114,26 @@ impl DeepImage {
     }
 }
 
-fn message(code: ffi::ExrResult) -> String {
+fn message(api: &ffi::Api, code: ffi::ExrResult) -> String {
     // SAFETY: the library returns a pointer to a static, NUL-terminated
     // message for any code (an "unknown error" text for unknown ones).
-    let text = unsafe { CStr::from_ptr(ffi::exr_get_default_error_message(code)) };
+    let text = unsafe { CStr::from_ptr((api.get_default_error_message)(code)) };
     text.to_string_lossy().into_owned()
 }
 
 /// A context that `exr_finish` closes however the caller leaves.
 struct Context {
+    api: &'static ffi::Api,
     raw: ffi::Context,
 }
 
 impl Drop for Context {
     fn drop(&mut self) {
+        let api = self.api;
         if !self.raw.is_null() {
             // SAFETY: `raw` came from a successful exr_start_*; finishing
             // it once (it is nulled by the call) is the required cleanup.
-            unsafe { ffi::exr_finish(&mut self.raw) };
+            unsafe { (api.finish)(&mut self.raw) };
         }
     }
 }
@@ -134,23 +142,31 @@ impl Context {
     /// Finishes explicitly, reporting the error a write's final flush and
     /// rename may give.
     fn finish(mut self) -> Result<(), String> {
+        let api = self.api;
         // SAFETY: as in `drop`; the handle is nulled so drop does nothing.
-        let rv = unsafe { ffi::exr_finish(&mut self.raw) };
+        let rv = unsafe { (api.finish)(&mut self.raw) };
         self.raw = std::ptr::null_mut();
-        ok(rv, "finish")
+        ok(api, rv, "finish")
     }
 }
 
-fn ok(rv: ffi::ExrResult, what: &str) -> Result<(), String> {
+fn ok(api: &ffi::Api, rv: ffi::ExrResult, what: &str) -> Result<(), String> {
     if rv == ffi::EXR_ERR_SUCCESS {
         Ok(())
     } else {
-        Err(format!("{what}: {}", message(rv)))
+        Err(format!("{what}: {}", message(api, rv)))
     }
 }
 
 fn c_path(path: &Path) -> Result<CString, String> {
     CString::new(path.as_os_str().as_encoded_bytes()).map_err(|_| "path holds a NUL byte".into())
+}
+
+/// Loads OpenEXRCore now (once per process; later calls return the first
+/// outcome), so that a caller can refuse a deep output before a render
+/// rather than after it. The error says what to install.
+pub fn load_library() -> io::Result<()> {
+    ffi::api().map(|_| ()).map_err(io::Error::other)
 }
 
 /// Writes `image` as a deep scanline OpenEXR file, whole or not at all.
@@ -161,14 +177,17 @@ pub fn write(path: &Path, image: &DeepImage) -> io::Result<()> {
 fn write_inner(path: &Path, image: &DeepImage) -> Result<(), String> {
     image.check()?;
     let name = c_path(path)?;
+    let api = ffi::api()?;
     let mut ctx = Context {
+        api,
         raw: std::ptr::null_mut(),
     };
     // SAFETY: `ctx.raw` is a valid out-pointer; `name` is NUL-terminated
     // and outlives the call; a null initializer selects the defaults.
     ok(
+        api,
         unsafe {
-            ffi::exr_start_write(
+            (api.start_write)(
                 &mut ctx.raw,
                 name.as_ptr(),
                 ffi::EXR_INTERMEDIATE_TEMP_FILE,
@@ -179,7 +198,7 @@ fn write_inner(path: &Path, image: &DeepImage) -> Result<(), String> {
     )?;
     let part = define_part(&ctx, image)?;
     // SAFETY: the part is fully defined; the context is open for writing.
-    ok(unsafe { ffi::exr_write_header(ctx.raw) }, "write header")?;
+    ok(api, unsafe { (api.write_header)(ctx.raw) }, "write header")?;
     let offsets = image.offsets();
     let w = image.width as usize;
     let mut packed: Vec<u8> = Vec::new();
@@ -203,7 +222,7 @@ fn write_inner(path: &Path, image: &DeepImage) -> Result<(), String> {
         // SAFETY: both buffers are live for the call and their lengths are
         // the sizes passed; uncompressed, packed and unpacked sizes agree.
         let rv = unsafe {
-            ffi::exr_write_deep_scanline_chunk(
+            (api.write_deep_scanline_chunk)(
                 ctx.raw,
                 part,
                 y,
@@ -214,19 +233,21 @@ fn write_inner(path: &Path, image: &DeepImage) -> Result<(), String> {
                 table.len() as u64,
             )
         };
-        ok(rv, &format!("write scanline {y}"))?;
+        ok(api, rv, &format!("write scanline {y}"))?;
     }
     ctx.finish()
 }
 
 /// Adds the deep part with its windows and channels; returns its index.
 fn define_part(ctx: &Context, image: &DeepImage) -> Result<c_int, String> {
+    let api = ctx.api;
     let mut part: c_int = 0;
     let part_name = CString::new("deep").expect("no NUL");
     // SAFETY: the context is open for writing; the out-pointer is valid.
     ok(
+        api,
         unsafe {
-            ffi::exr_add_part(
+            (api.add_part)(
                 ctx.raw,
                 part_name.as_ptr(),
                 ffi::EXR_STORAGE_DEEP_SCANLINE,
@@ -238,14 +259,9 @@ fn define_part(ctx: &Context, image: &DeepImage) -> Result<c_int, String> {
     let (fw, fh) = (image.full.0 as i32, image.full.1 as i32);
     // SAFETY: as above, for the part just added.
     ok(
+        api,
         unsafe {
-            ffi::exr_initialize_required_attr_simple(
-                ctx.raw,
-                part,
-                fw,
-                fh,
-                ffi::EXR_COMPRESSION_NONE,
-            )
+            (api.initialize_required_attr_simple)(ctx.raw, part, fw, fh, ffi::EXR_COMPRESSION_NONE)
         },
         "initialise header",
     )?;
@@ -264,19 +280,22 @@ fn define_part(ctx: &Context, image: &DeepImage) -> Result<c_int, String> {
     };
     // SAFETY: the boxes are live for the calls; the part exists.
     ok(
-        unsafe { ffi::exr_set_display_window(ctx.raw, part, &display) },
+        api,
+        unsafe { (api.set_display_window)(ctx.raw, part, &display) },
         "display window",
     )?;
     ok(
-        unsafe { ffi::exr_set_data_window(ctx.raw, part, &data) },
+        api,
+        unsafe { (api.set_data_window)(ctx.raw, part, &data) },
         "data window",
     )?;
     for channel in &image.channels {
         let c = CString::new(channel.as_str()).map_err(|_| "channel name holds a NUL")?;
         // SAFETY: `c` is NUL-terminated and live; the library copies it.
         ok(
+            api,
             unsafe {
-                ffi::exr_add_channel(
+                (api.add_channel)(
                     ctx.raw,
                     part,
                     c.as_ptr(),
@@ -299,12 +318,15 @@ pub fn read(path: &Path) -> io::Result<DeepImage> {
 
 fn read_inner(path: &Path) -> Result<DeepImage, String> {
     let name = c_path(path)?;
+    let api = ffi::api()?;
     let mut ctx = Context {
+        api,
         raw: std::ptr::null_mut(),
     };
     // SAFETY: as for writing; a null initializer selects the defaults.
     ok(
-        unsafe { ffi::exr_start_read(&mut ctx.raw, name.as_ptr(), std::ptr::null()) },
+        api,
+        unsafe { (api.start_read)(&mut ctx.raw, name.as_ptr(), std::ptr::null()) },
         "open",
     )?;
     let mut image = read_header(&ctx)?;
@@ -316,7 +338,8 @@ fn read_inner(path: &Path) -> Result<DeepImage, String> {
         // SAFETY: the context is open for reading; `info` is a valid
         // out-pointer.
         ok(
-            unsafe { ffi::exr_read_scanline_chunk_info(ctx.raw, 0, y, &mut info) },
+            api,
+            unsafe { (api.read_scanline_chunk_info)(ctx.raw, 0, y, &mut info) },
             &format!("scanline {y}"),
         )?;
         if info.height != 1
@@ -329,8 +352,9 @@ fn read_inner(path: &Path) -> Result<DeepImage, String> {
         // SAFETY: `table` holds exactly `sample_count_table_size` bytes
         // (checked above); a null packed pointer reads the table alone.
         ok(
+            api,
             unsafe {
-                ffi::exr_read_deep_chunk(
+                (api.read_deep_chunk)(
                     ctx.raw,
                     0,
                     &info,
@@ -351,8 +375,9 @@ fn read_inner(path: &Path) -> Result<DeepImage, String> {
         // SAFETY: `packed` holds exactly `packed_size` bytes (checked
         // against the table, whose own size was checked first).
         ok(
+            api,
             unsafe {
-                ffi::exr_read_deep_chunk(
+                (api.read_deep_chunk)(
                     ctx.raw,
                     0,
                     &info,
@@ -394,18 +419,20 @@ fn line_counts(table: &[u8], y: c_int) -> Result<Vec<u32>, String> {
 
 /// The part's windows and channels, checked to be what [`write`] makes.
 fn read_header(ctx: &Context) -> Result<DeepImage, String> {
+    let api = ctx.api;
     let (mut parts, mut storage, mut compression) = (0, 0, 0);
     // SAFETY: the context is open for reading; the out-pointers are valid.
     unsafe {
-        ok(ffi::exr_get_count(ctx.raw, &mut parts), "part count")?;
+        ok(api, (api.get_count)(ctx.raw, &mut parts), "part count")?;
         if parts != 1 {
             return Err(format!(
                 "{parts} parts; a deep image of one part is expected"
             ));
         }
-        ok(ffi::exr_get_storage(ctx.raw, 0, &mut storage), "storage")?;
+        ok(api, (api.get_storage)(ctx.raw, 0, &mut storage), "storage")?;
         ok(
-            ffi::exr_get_compression(ctx.raw, 0, &mut compression),
+            api,
+            (api.get_compression)(ctx.raw, 0, &mut compression),
             "compression",
         )?;
     }
@@ -421,11 +448,13 @@ fn read_header(ctx: &Context) -> Result<DeepImage, String> {
     // SAFETY: as above.
     unsafe {
         ok(
-            ffi::exr_get_display_window(ctx.raw, 0, &mut display),
+            api,
+            (api.get_display_window)(ctx.raw, 0, &mut display),
             "display window",
         )?;
         ok(
-            ffi::exr_get_data_window(ctx.raw, 0, &mut data),
+            api,
+            (api.get_data_window)(ctx.raw, 0, &mut data),
             "data window",
         )?;
     }
@@ -452,11 +481,13 @@ fn read_header(ctx: &Context) -> Result<DeepImage, String> {
 }
 
 fn channel_names(ctx: &Context) -> Result<Vec<String>, String> {
+    let api = ctx.api;
     let mut list: *const ffi::ChannelList = std::ptr::null();
     // SAFETY: the context is open; the library returns a pointer into its
     // own header, valid until the context is finished (after this copy).
     ok(
-        unsafe { ffi::exr_get_channels(ctx.raw, 0, &mut list) },
+        api,
+        unsafe { (api.get_channels)(ctx.raw, 0, &mut list) },
         "channels",
     )?;
     if list.is_null() {

@@ -96,7 +96,9 @@ pub use phase::{HenyeyGreenstein, Phase};
 pub use ray::Ray;
 pub use render::{render, Rendered, Window};
 pub use sampling::{Rng, SampleStream, SamplerKind};
-pub use scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
+pub use scene::{
+    Budget, Crop, MajorantMode, RenderSettings, Scene, DEFAULT_SPP, DEFAULT_STEP_VOXELS,
+};
 pub use shutter::Shutter;
 pub use spectrum::Spectrum;
 pub use stats::{Counters, RenderStats};

@@ -33,12 +33,10 @@ pub struct Scene<M> {
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum MajorantMode {
     /// Whichever of the two a probe of the scene finds cheaper
-    /// ([`crate::majorant_choice`]); the scene crate's default.
-    Auto,
-    /// The field's own local segments (its hierarchy or grid); what
-    /// [`RenderSettings::default`] walks, so that a render's structure is
-    /// fixed unless asked to be chosen.
+    /// ([`crate::majorant_choice`]).
     #[default]
+    Auto,
+    /// The field's own local segments (its hierarchy or grid).
     Hierarchy,
     /// One global majorant over the field's bounds (Mitsuba 3 style).
     Global,
@@ -69,7 +67,17 @@ pub enum Budget {
     Time(f64),
 }
 
+/// Samples per pixel when no budget is given.
+pub const DEFAULT_SPP: u32 = 64;
+
+/// The ray marchers' step in voxels when none is given.
+pub const DEFAULT_STEP_VOXELS: f32 = 0.5;
+
 /// Everything about how to render, independent of the scene.
+///
+/// Its [`Default`] is the renderer's one set of defaults: each settings
+/// enum's own `Default`, [`DEFAULT_SPP`] and [`DEFAULT_STEP_VOXELS`]; the
+/// scene files and the command line declare theirs from these.
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
     pub integrator: IntegratorKind,
@@ -146,15 +154,15 @@ impl Crop {
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
-            integrator: IntegratorKind::Path,
-            transmittance: TransmittanceEstimator::Residual,
-            majorant: MajorantMode::Hierarchy,
-            budget: Budget::Spp(64),
+            integrator: IntegratorKind::default(),
+            transmittance: TransmittanceEstimator::default(),
+            majorant: MajorantMode::default(),
+            budget: Budget::Spp(DEFAULT_SPP),
             seed: 0,
-            sampler: SamplerKind::Sobol,
+            sampler: SamplerKind::default(),
             adaptive: None,
             max_depth: None,
-            step_voxels: 0.5,
+            step_voxels: DEFAULT_STEP_VOXELS,
             shadow_step_voxels: None,
             light_grid: LightGridSettings::default(),
             tile_size: 16,
@@ -164,9 +172,9 @@ impl Default for RenderSettings {
             control: None,
             shutter: Shutter::INSTANT,
             compositing: Compositing::default(),
-            guiding: GuidingMode::Auto,
-            light_sampling: LightSampling::Auto,
-            sunward: Sunward::Auto,
+            guiding: GuidingMode::default(),
+            light_sampling: LightSampling::default(),
+            sunward: Sunward::default(),
         }
     }
 }

@@ -132,6 +132,7 @@ fn a_rendered_pixel_sees_the_time_averaged_transmittance() {
         max_depth: Some(0),
         shutter: SHUTTER,
         progress: false,
+        majorant: cirrus_render::MajorantMode::Hierarchy,
         ..Default::default()
     };
     let r = render(&scene, &settings);
@@ -278,6 +279,7 @@ fn a_closed_shutter_or_no_velocity_renders_bit_identical() {
             budget: Budget::Spp(8),
             shutter,
             progress: false,
+            majorant: cirrus_render::MajorantMode::Hierarchy,
             ..Default::default()
         };
         render(&scene, &settings).image.rgba

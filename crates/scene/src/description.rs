@@ -66,14 +66,14 @@ declare_settings! {
     /// `[render]`: how to render.
     table render: RenderSpec, RenderFlags, one {
     /// Samples per pixel.
-    spp: u32, flag(long, conflicts_with = "time"), default(64), example(3);
+    spp: u32, flag(long, conflicts_with = "time"), default(cirrus_render::DEFAULT_SPP), example(3);
     /// Render passes until this many seconds are spent (instead of spp).
     time: f64, flag(long), unset("off"), example(0.5);
     /// Same seed, same image, on any thread count.
     seed: u64, flag(long), default(0), example(7);
     /// Sample numbers: Owen-scrambled Sobol points for the first path
     /// vertices, or independent random numbers.
-    sampler: SamplerKind, flag(long, value_enum), default(SamplerKind::Sobol),
+    sampler: SamplerKind, flag(long, value_enum), default(SamplerKind::default()),
         example(SamplerKind::Random);
     /// Adaptive sampling: a pixel stops once the relative standard error
     /// of its mean is below this (e.g. 0.02); with --time, passes go to the
@@ -83,14 +83,14 @@ declare_settings! {
     min_spp: u32, flag(long), default(16), example(4);
     /// The integrator: unbiased path tracing, or ray marching (single
     /// scattering; two-pass over a cached light grid).
-    integrator: IntegratorKind, flag(long, value_enum), default(IntegratorKind::Path),
+    integrator: IntegratorKind, flag(long, value_enum), default(IntegratorKind::default()),
         example(IntegratorKind::RayMarch);
     /// Shadow-ray transmittance estimator.
     transmittance: TransmittanceEstimator, flag(long, value_enum),
-        default(TransmittanceEstimator::Residual), example(TransmittanceEstimator::Ratio);
+        default(TransmittanceEstimator::default()), example(TransmittanceEstimator::Ratio);
     /// Majorants for tracking: the brick hierarchy, one global majorant
     /// (Mitsuba-like), or whichever a probe of the scene finds cheaper.
-    majorant: MajorantMode, flag(long, value_enum), default(MajorantMode::Auto),
+    majorant: MajorantMode, flag(long, value_enum), default(MajorantMode::default()),
         example(MajorantMode::Global);
     /// Path guiding: learn where the light comes from (a radiance cache
     /// trained on the frame's own paths); `on` plays roulette with paths
@@ -98,14 +98,14 @@ declare_settings! {
     /// `directions` also scatters toward the learned light, `distances`
     /// also decides collisions by the learned light ahead; `auto` guides
     /// where that pays, which measured is nowhere yet.
-    guiding: GuidingMode, flag(long, value_enum), default(GuidingMode::Auto),
+    guiding: GuidingMode, flag(long, value_enum), default(GuidingMode::default()),
         example(GuidingMode::On);
     /// Next-event estimation at each scattering vertex: a shadow ray to
     /// one light picked by its in-scattered light there seen through the
     /// media (a coarse shadow grid; half the shadow rays under a sun and a
     /// sky, and few deep in a thick cloud), or to every light; `auto` picks
     /// one under a constant sky, every light under a map.
-    light_sampling: LightSampling, flag(long, value_enum), default(LightSampling::Auto),
+    light_sampling: LightSampling, flag(long, value_enum), default(LightSampling::default()),
         example(LightSampling::All);
     /// Sunward scattering: at each scattering vertex, also scatter toward
     /// the sun and gather its light at the next vertex, weighed against
@@ -114,12 +114,12 @@ declare_settings! {
     /// forward-scattering phase function); `auto` runs it where the phase
     /// function's mean cosine is at least 0.6, where it was measured to
     /// pay.
-    sunward: Sunward, flag(long, value_enum), default(Sunward::Auto), example(Sunward::Off);
+    sunward: Sunward, flag(long, value_enum), default(Sunward::default()), example(Sunward::Off);
     /// Real scattering events per path (0: only the sky through the volume,
     /// 1: single scattering).
     max_depth: u32, flag(long), unset("unlimited, ended by Russian roulette"), example(1);
     /// Ray-march step in voxels.
-    step: f32, flag(long), default(0.5), example(2.0);
+    step: f32, flag(long), default(cirrus_render::DEFAULT_STEP_VOXELS), example(2.0);
     /// The ray marchers' shadow-ray step in voxels, as vdb_render's
     /// -shadowstep.
     shadow_step: f32, flag(long), unset("the step"), example(3.0);

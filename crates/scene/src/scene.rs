@@ -156,6 +156,12 @@ impl Scene {
         if let Some(c) = &outputs.crop {
             c.validate(settings.res.0, settings.res.1)?;
         }
+        if let Some(deep) = &outputs.deep {
+            // Before the render, not after it: the library is loaded at
+            // run time and may be missing.
+            cirrus_deep_exr::load_library()
+                .map_err(|e| Error::file(format!("{}: {e}", deep.display())))?;
+        }
         crate::compositing::configure(
             &mut settings.render,
             &outputs,

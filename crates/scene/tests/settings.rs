@@ -198,3 +198,42 @@ fn every_setting_reaches_the_renderer() {
         assert_ne!(a, b, "{keyword} changes nothing the renderer is handed");
     }
 }
+
+/// The render crate's `RenderSettings::default()` is the render a scene
+/// with nothing set gets (the command line without flags): every setting
+/// equal, and so the same image from both.
+#[test]
+fn the_render_crates_defaults_are_the_declared_ones() {
+    use cirrus_render::{Budget, RenderSettings};
+    let mut scene = Scene::load(&repo().join("data/cloud.vdb")).unwrap();
+    let declared = scene.settings().unwrap().render;
+    let library = RenderSettings {
+        progress: false,
+        ..RenderSettings::default()
+    };
+    assert_eq!(format!("{declared:?}"), format!("{library:?}"));
+
+    // A small view, its sample count lowered alike on both sides.
+    scene.apply(&Overrides {
+        res: Some((20, 16)),
+        spp: Some(2),
+        ..Default::default()
+    });
+    let mut cache = VolumeCache::default();
+    let p = scene.prepare(&mut cache, None).unwrap();
+    let library = RenderSettings {
+        progress: false,
+        budget: Budget::Spp(2),
+        ..RenderSettings::default()
+    };
+    let a = cirrus_render::render(&p.scene, &p.settings).image;
+    let b = cirrus_render::render(&p.scene, &library).image;
+    assert!(
+        a.rgba.iter().any(|px| px[3] > 0.0),
+        "the view sees the cloud"
+    );
+    let bits = |img: &cirrus_render::Image| -> Vec<u32> {
+        img.rgba.iter().flatten().map(|v| v.to_bits()).collect()
+    };
+    assert_eq!(bits(&a), bits(&b));
+}

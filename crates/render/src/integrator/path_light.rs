@@ -11,7 +11,7 @@ use super::path_scatter::mixture_pdf;
 use super::path_sunward::Arrival;
 use super::LightParts;
 use crate::guiding::BinDistribution;
-use crate::light::LightSample;
+use crate::light::{Environment, LightSample};
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
@@ -27,7 +27,7 @@ pub(super) struct Vertex<'a> {
     pub ray_in: &'a Ray,
     pub phase: &'a Phase,
     /// Weight against the scattered direction (false at the last allowed
-    /// vertex, whose continuation cannot reach a light).
+    /// vertex, whose continuation is not traced).
     pub mis: bool,
     /// The learned light a guided vertex's direction is partly drawn
     /// from: the scattered direction's density is then the mixture's.
@@ -70,13 +70,33 @@ impl<M: Media> PathTracer<'_, M> {
         }
         if let Some(env) = self.lights.environment.as_ref().filter(|_| sky_picked) {
             let (u1, u2) = draws.get_2d(Draw::SkyDirection, v.index);
-            let s = env.sample(u1, u2);
+            let s = self.sky_sample(v, env, u1, u2);
             c.env_samples += 1;
             // A zero-density sample (a pole) is dropped without a shadow ray.
             c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
             l.sky = self.light_term::<S>(v, s, v.choice.sky, Draw::SkyShadow, draws, c);
         }
         l
+    }
+
+    /// The sky's direction at `v`: drawn from the sky itself, except for a
+    /// constant sky at a vertex without MIS (the last one a path may
+    /// scatter at), where it is drawn from the phase function, the
+    /// importance sampling of `f * L` for any constant `L`. There nothing
+    /// weighs the draw against another strategy, and a sky sampled
+    /// uniformly against a narrow phase lobe (Mie scattering by cloud
+    /// droplets) is a heavy-tailed estimate that a light pick's small
+    /// probability then multiplies into fireflies.
+    fn sky_sample(&self, v: &Vertex, env: &Environment, u1: f32, u2: f32) -> LightSample {
+        if v.mis || env.map.is_some() {
+            return env.sample(u1, u2);
+        }
+        let (to_light, pdf) = v.phase.sample(v.ray_in.dir, u1, u2);
+        LightSample {
+            to_light,
+            radiance: env.radiance,
+            pdf: Some(pdf),
+        }
     }
 
     /// `f * Li * T * w / (pick p_light)` for one light sample, `pick` the

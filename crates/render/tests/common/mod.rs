@@ -3,8 +3,8 @@
 
 use cirrus_render::Bounds3;
 use cirrus_render::{
-    render, Budget, Camera, Crop, Environment, GridField, Image, IntegratorKind, Lights, Media,
-    Medium, RenderSettings, Rendered, Scene, Sun, Volumes,
+    render, Budget, Camera, Crop, Environment, GridField, Image, IntegratorKind, Lights,
+    MajorantMode, Media, Medium, RenderSettings, Rendered, Scene, Sun, Volumes,
 };
 use glam::Vec3;
 
@@ -88,11 +88,15 @@ pub fn render_through<M: Media>(
     render(&scene, settings)
 }
 
+/// The tests' settings: the defaults, but the field's own majorant
+/// hierarchy always (not the probe's choice), so that what a test traces
+/// does not move with the probe.
 pub fn settings(integrator: IntegratorKind, spp: u32, seed: u64) -> RenderSettings {
     RenderSettings {
         integrator,
         budget: Budget::Spp(spp),
         seed,
+        majorant: MajorantMode::Hierarchy,
         progress: false,
         ..Default::default()
     }
