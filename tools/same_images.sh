@@ -10,7 +10,7 @@
 # automatic majorants, .nvdb and .cbrk input, and crops with their merge.
 # Prints one line per image and exits non-zero if any differ. NEW_FLAGS,
 # if set, is added to every render of the new build (say, to turn off a
-# default the old build did not have: NEW_FLAGS="--guiding off").
+# default the old build did not have: NEW_FLAGS="--sunward off").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 old=$(readlink -f "$1")

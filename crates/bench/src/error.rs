@@ -11,12 +11,9 @@
 //!
 //! Beside the estimators and structures (all with the default Sobol
 //! sampler), configurations of the default one show what the sampler,
-//! adaptive sampling, guiding, light selection and denoising each give:
+//! adaptive sampling, light selection and denoising each give:
 //! independent random numbers instead of Sobol points, adaptive sampling
-//! at `--noise-threshold`, path guiding (`--guiding on`, roulette and
-//! splitting, `--guiding directions`, guided directions as well, and
-//! `--guiding distances`, guided collisions too; their training counted in
-//! the time), a shadow ray to every light at each vertex
+//! at `--noise-threshold`, a shadow ray to every light at each vertex
 //! (`--light-sampling all`) instead of to one, sunward scattering
 //! (`--sunward on`; every other row renders with it off, so that the
 //! estimators compare as Mitsuba and Cycles trace),
@@ -29,8 +26,8 @@ use crate::fixed_grid::FixedGridField;
 use crate::BenchResult;
 use ceiling::CollisionCost;
 use cirrus_render::{
-    render, Adaptive, Budget, GuidingMode, IntegratorKind, LightSampling, MajorantMode, Medium,
-    RenderSettings, SamplerKind, Scene, Sunward, TransmittanceEstimator, Volumes,
+    render, Adaptive, Budget, IntegratorKind, LightSampling, MajorantMode, Medium, RenderSettings,
+    SamplerKind, Scene, Sunward, TransmittanceEstimator, Volumes,
 };
 use cirrus_scene::{Scene as SceneFile, SceneFlags, VolumeCache};
 use std::fmt::Write as _;
@@ -97,7 +94,6 @@ struct Config {
     sampler: SamplerKind,
     adaptive: Option<Adaptive>,
     denoise: bool,
-    guiding: GuidingMode,
     light_sampling: LightSampling,
     sunward: Sunward,
 }
@@ -114,7 +110,6 @@ impl Config {
             sampler: SamplerKind::Sobol,
             adaptive: None,
             denoise: false,
-            guiding: GuidingMode::Off,
             light_sampling: LightSampling::default(),
             sunward: Sunward::Off,
         }
@@ -178,18 +173,6 @@ fn configs(args: &ErrorArgs) -> Vec<Config> {
             min_spp: cirrus_scene::description::RenderSpec::default().min_spp(),
         }),
         ..default(&format!("adaptive {}%", 100.0 * args.adaptive_threshold))
-    });
-    v.push(Config {
-        guiding: GuidingMode::On,
-        ..default("guided roulette and splitting")
-    });
-    v.push(Config {
-        guiding: GuidingMode::Directions,
-        ..default("guided directions")
-    });
-    v.push(Config {
-        guiding: GuidingMode::Distances,
-        ..default("guided distances")
     });
     v.push(Config {
         sunward: Sunward::On,
@@ -310,7 +293,6 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
         sampler: c.sampler,
         adaptive: c.adaptive,
         aovs: c.denoise,
-        guiding: c.guiding,
         light_sampling: c.light_sampling,
         sunward: c.sunward,
         progress: false,

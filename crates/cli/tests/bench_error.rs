@@ -26,13 +26,11 @@ fn error_bench_measures_every_configuration_and_reports_the_ceiling() {
     assert!(out.status.success(), "{stderr}");
 
     // 9 tracking configurations (3 estimators x 3 structures), the default
-    // one with the automatic structure, random numbers, adaptive, guided
-    // roulette and splitting, guided directions, guided distances, sunward
-    // scattering, every
-    // light per vertex and (where the library loads) denoised, and 2 ray
-    // marchers at one step, each at 2 budgets.
+    // one with the automatic structure, random numbers, adaptive, sunward
+    // scattering, every light per vertex and (where the library loads)
+    // denoised, and 2 ray marchers at one step, each at 2 budgets.
     let denoised = !stderr.contains("not measuring denoising");
-    let configs = 9 + 8 + usize::from(denoised) + 2;
+    let configs = 9 + 5 + usize::from(denoised) + 2;
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len(), 2 * configs, "{csv}");
@@ -40,9 +38,6 @@ fn error_bench_measures_every_configuration_and_reports_the_ceiling() {
         "\"automatic structure: ",
         "\"random numbers: ",
         "\"adaptive 2%: ",
-        "\"guided roulette and splitting: ",
-        "\"guided directions: ",
-        "\"guided distances: ",
         "\"sunward scattering: ",
         "\"every light per vertex: ",
     ] {

@@ -108,6 +108,22 @@ fn scene_file_errors_name_the_file_key_and_line() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// `--guiding` (learned path guiding, removed) is refused with why and
+/// where its record is, before anything renders.
+#[test]
+fn guiding_is_refused_with_the_reason() {
+    let d = scratch("guiding");
+    let out = d.join("g.exr");
+    let (ok, _, err) = cirrus(&["render", "data/cloud.vdb", "--guiding", "on", "-o", s(&out)]);
+    assert!(!ok);
+    assert!(
+        err.contains("removed") && err.contains("BENCHMARKS.md") && err.contains("0258f19"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// Two volumes, flags over the file, and the stats of a scene with only a
 /// sun: no environment samples, no emission lookups, the grids named and
 /// no others.

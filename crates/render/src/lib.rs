@@ -51,7 +51,6 @@ pub mod env_map;
 pub mod error;
 pub mod exr_layers;
 pub mod film;
-pub mod guiding;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
@@ -80,7 +79,6 @@ pub use control::RenderControl;
 pub use env_map::EnvMap;
 pub use error::{Error, Result};
 pub use film::{AovImage, Image};
-pub use guiding::GuidingMode;
 pub use integrator::{
     AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, LightSampling,
     PathTracer, RayMarcher, Sample, Sunward, TwoPassMarcher,

@@ -12,15 +12,12 @@ use crate::camera::Camera;
 use crate::compositing::{DepthHoldout, Layers};
 use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Image, Tile};
-use crate::guiding::{self, Frame, Guide, GuidingMode, GuidingStats, TrainingSchedule};
-use crate::integrator::{
-    CameraSampler, IntegratorKind, LightGrid, PathTracer, RayMarcher, TwoPassMarcher,
-};
+use crate::integrator::{CameraSampler, IntegratorKind, LightGrid, RayMarcher, TwoPassMarcher};
 use crate::light::Lights;
 use crate::majorant_choice;
 use crate::medium::{GlobalMedia, Media};
 use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGrid};
-use crate::sampling::{Draw, Rng, SampleStream, SamplerKind};
+use crate::sampling::{Draw, SampleStream, SamplerKind};
 use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
 use crate::shutter::Shutter;
 use crate::stats::{Counters, RenderStats};
@@ -121,7 +118,6 @@ fn render_with<M: Media>(
         setup_seconds: out.setup_seconds,
         counters,
         rays_per_second: counters.paths as f64 / wall_seconds.max(1e-9),
-        guiding: out.guiding,
         light_sampling: out.light_sampling,
         sunward: match settings.integrator {
             IntegratorKind::Path => settings.sunward.name().into(),
@@ -154,9 +150,8 @@ struct Integrated {
     aovs: Option<AovImage>,
     layers: Option<Layers>,
     /// Seconds from the render's start to its first sample pass (shadow
-    /// grids, guide training).
+    /// grids).
     setup_seconds: f64,
-    guiding: Option<GuidingStats>,
     light_sampling: String,
 }
 
@@ -176,20 +171,16 @@ fn integrate<M: Media>(
         aovs,
         layers,
         setup_seconds,
-        guiding: None,
         light_sampling: String::new(),
     };
     match settings.integrator {
         IntegratorKind::Path => {
             let tracer = path_tracer(medium, &lights, settings, shadows);
             let light_sampling = light_sampling_stat(settings, &tracer, shadows);
-            let (guide, stats) = trained_guide(medium, camera, settings, &tracer);
-            let s = tracer.with_guide(guide.as_ref());
             let setup = start.elapsed().as_secs_f64();
             Integrated {
-                guiding: Some(stats),
                 light_sampling,
-                ..done(run(&s, camera, settings, start, counters), setup)
+                ..done(run(&tracer, camera, settings, start, counters), setup)
             }
         }
         IntegratorKind::RayMarch => {
@@ -534,58 +525,3 @@ impl Progress {
         }
     }
 }
-
-/// The radiance cache a path-traced render follows, trained as
-/// `settings.guiding` says ([`GuidingMode`]), with its
-/// statistics; `None` when it follows none.
-fn trained_guide<'m, M: Media>(
-    media: &'m M,
-    camera: &Camera,
-    settings: &RenderSettings,
-    tracer: &PathTracer<'m, M>,
-) -> (Option<Guide>, GuidingStats) {
-    let frame = Frame {
-        camera,
-        shutter: settings.shutter,
-        sampler: settings.sampler,
-        seed: settings.seed,
-    };
-    let decisions = settings.guiding.decisions();
-    let mode = match settings.guiding {
-        GuidingMode::Auto => "auto: off (guiding pays on no scene measured yet)".to_string(),
-        m => m.name().to_string(),
-    };
-    let Some(decisions) = decisions else {
-        return (
-            None,
-            GuidingStats {
-                mode,
-                ..Default::default()
-            },
-        );
-    };
-    let spp = match settings.budget {
-        Budget::Spp(n) => n,
-        Budget::Time(_) => TIMED_TRAINING_SPP,
-    };
-    let (mut guide, mut stats, _) = guiding::train(
-        media.bounds(),
-        decisions,
-        &frame,
-        &TrainingSchedule::for_spp(spp),
-        |guide, ray, draws, c, recorder| {
-            tracer.sample_with(Some(guide), ray, draws, c, recorder);
-        },
-    );
-    stats.mode = mode;
-    // The phase function at the media's centre stands for all of them
-    // (one medium is the common case; a different phase elsewhere makes
-    // the guided distances' estimate worse, never biased).
-    let centre = media.bounds().centre();
-    let phase = media.interaction(centre, 0.0, &mut Rng::new(0, 0, 0)).phase;
-    guide.scatter_light(phase);
-    (Some(guide), stats)
-}
-
-/// The samples per pixel a time-budgeted render's training is planned for.
-const TIMED_TRAINING_SPP: u32 = 64;

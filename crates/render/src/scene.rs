@@ -10,7 +10,6 @@ use crate::camera::Camera;
 use crate::compositing::Compositing;
 use crate::control::RenderControl;
 use crate::error::{Error, Result};
-use crate::guiding::GuidingMode;
 use crate::integrator::{IntegratorKind, LightGridSettings};
 use crate::integrator::{LightSampling, Sunward};
 use crate::light::Lights;
@@ -119,9 +118,6 @@ pub struct RenderSettings {
     /// Light groups, holdout depth, Cryptomatte and deep samples
     /// ([`crate::compositing`]); the default keeps none.
     pub compositing: Compositing,
-    /// Whether the path tracer learns and follows a radiance cache
-    /// ([`crate::guiding`]).
-    pub guiding: GuidingMode,
     /// Whether next-event estimation samples every light at each vertex,
     /// or one ([`LightSampling`]).
     pub light_sampling: LightSampling,
@@ -172,7 +168,6 @@ impl Default for RenderSettings {
             control: None,
             shutter: Shutter::INSTANT,
             compositing: Compositing::default(),
-            guiding: GuidingMode::default(),
             light_sampling: LightSampling::default(),
             sunward: Sunward::default(),
         }

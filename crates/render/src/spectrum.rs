@@ -98,6 +98,13 @@ pub trait Spectrum: Copy + Send + Sync + std::fmt::Debug + 'static {
     fn escaped_alpha(beta: Vec3) -> f32;
 }
 
+/// Luminance (Rec. 709): how a colour is weighed where one number stands
+/// for it (the light choice's estimates).
+#[inline]
+pub fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
 /// Extinction at a tentative collision, at the ray's time, counted, with
 /// majorant violations (density above the segment's bound) counted too.
 #[inline]

@@ -41,17 +41,10 @@ pub struct Counters {
     /// Times the environment was consulted: directions sampled from it
     /// for next-event estimation, and escaped rays looking it up.
     pub env_samples: u64,
-    /// Path copies made by guided splitting, and paths ended by guided
-    /// roulette (`integrator/path_split.rs`).
-    pub split_copies: u64,
-    pub roulette_ends: u64,
     /// Directions drawn toward the sun by sunward scattering
     /// (`integrator/path_sunward.rs`), each a free flight and, where it
     /// collides, a shadow ray.
     pub sunward_rays: u64,
-    /// Tentative collisions made real or null by the learned estimate of
-    /// what each brings (`tracking/guided.rs`), not by the density alone.
-    pub guided_collisions: u64,
 }
 
 impl AddAssign for Counters {
@@ -70,10 +63,7 @@ impl AddAssign for Counters {
         self.nee_rays_sun += o.nee_rays_sun;
         self.nee_rays_env += o.nee_rays_env;
         self.env_samples += o.env_samples;
-        self.split_copies += o.split_copies;
-        self.roulette_ends += o.roulette_ends;
         self.sunward_rays += o.sunward_rays;
-        self.guided_collisions += o.guided_collisions;
     }
 }
 
@@ -129,9 +119,6 @@ pub struct RenderStats {
     pub denoise_seconds: f64,
     /// Camera paths per second of wall time.
     pub rays_per_second: f64,
-    /// What the path tracer's radiance cache was and cost (`None` for
-    /// the marchers).
-    pub guiding: Option<crate::guiding::GuidingStats>,
 }
 
 impl RenderStats {

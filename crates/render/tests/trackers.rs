@@ -4,8 +4,8 @@
 mod common;
 
 use cirrus_render::tracking::{
-    ratio_tracking, residual_ratio_tracking, sample_free_flight, sample_guided_free_flight,
-    track_length_transmittance, transmittance, FreeFlight, TransmittanceEstimator,
+    ratio_tracking, residual_ratio_tracking, sample_free_flight, track_length_transmittance,
+    transmittance, FreeFlight, TransmittanceEstimator,
 };
 use cirrus_render::Bounds3;
 use cirrus_render::{
@@ -225,12 +225,11 @@ fn quadrature_collision_mean<M: Media>(medium: &M, ray: &Ray, f: impl Fn(f32) ->
 }
 
 #[test]
-fn guided_flights_keep_the_analog_flights_expectations() {
+fn delta_tracked_flights_collide_with_density_sigma_t_times_transmittance() {
     // Through a heterogeneous field under its global majorant (null
-    // collisions at most tentative points), with a worth that varies by
-    // orders of magnitude along the ray: the weighted escape estimates the
-    // transmittance, and the weighted collision point the analog flight's
-    // collision density.
+    // collisions at most tentative points): the escape frequency is the
+    // transmittance, and the mean collision point that of the density
+    // `sigma_t T` along the ray.
     let field = common::cloud_field(4);
     let Bounds3 { min: lo, max: hi } = field.bounds();
     let centre = 0.5 * (lo + hi);
@@ -240,23 +239,19 @@ fn guided_flights_keep_the_analog_flights_expectations() {
         centre - Vec3::new(2.0, 0.3, 0.1),
         Vec3::new(1.0, 0.15, 0.05).normalize(),
     );
-    let worth = |p: Vec3| Some(10.0 * (4.0 * (p.x - centre.x)).exp());
     let exact_t = quadrature_transmittance(&medium, &ray);
     let exact_at = quadrature_collision_mean(&medium, &ray, |t| t as f64);
     let mut c = Counters::default();
-    let mut flight = |rng: &mut Rng, weighted: bool| {
+    let mut flight = |rng: &mut Rng| {
         let mut beta = Vec3::ONE;
-        let f =
-            sample_guided_free_flight(&global, &ray, f32::INFINITY, &mut beta, rng, &mut c, worth);
-        let w = if weighted { beta.x } else { 1.0 };
-        (f, w)
+        sample_free_flight::<f32, _>(&global, &ray, f32::INFINITY, &mut beta, rng, &mut c)
     };
-    let (escape, se_e) = estimate(40_000, 30, |rng| match flight(rng, true) {
-        (FreeFlight::Escaped, w) => w,
+    let (escape, se_e) = estimate(40_000, 30, |rng| match flight(rng) {
+        FreeFlight::Escaped => 1.0,
         _ => 0.0,
     });
-    let (at, se_at) = estimate(40_000, 31, |rng| match flight(rng, true) {
-        (FreeFlight::Collision { t }, w) => w * t,
+    let (at, se_at) = estimate(40_000, 31, |rng| match flight(rng) {
+        FreeFlight::Collision { t } => t,
         _ => 0.0,
     });
     assert!(
@@ -267,15 +262,15 @@ fn guided_flights_keep_the_analog_flights_expectations() {
         (at - exact_at).abs() <= 5.0 * se_at,
         "collision mean {at} vs {exact_at} (se {se_at})"
     );
-    // The same flights without their branch weights are another
-    // distribution: the test can tell.
-    let (unweighted, se_u) = estimate(40_000, 32, |rng| match flight(rng, false) {
-        (FreeFlight::Escaped, w) => w,
-        _ => 0.0,
-    });
+    // The collision point's mean differs from the unweighted ray's
+    // midpoint in the field: the test can tell a uniform distance.
+    let (t0, t1) = Bounds3::new(lo, hi)
+        .clip_ray(ray.origin, ray.dir, 0.0, f32::INFINITY)
+        .unwrap();
+    let uniform = f64::from(0.5 * (t0 + t1)) * (1.0 - exact_t);
     assert!(
-        (unweighted - exact_t).abs() > 5.0 * se_u,
-        "unweighted escape {unweighted} vs T {exact_t} (se {se_u})"
+        (uniform - exact_at).abs() > 5.0 * se_at,
+        "{uniform} vs {exact_at}"
     );
     assert!(c.null_collisions > c.real_collisions / 4, "{c:?}");
 }

@@ -22,8 +22,8 @@ use std::path::PathBuf;
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    GuidingMode, IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward,
-    TransmittanceEstimator, VelocityUnit,
+    IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward, TransmittanceEstimator,
+    VelocityUnit,
 };
 
 use crate::description::Colour;
@@ -71,7 +71,6 @@ macro_rules! shown_by_name {
     )*};
 }
 shown_by_name!(
-    GuidingMode,
     LightSampling,
     Sunward,
     IntegratorKind,

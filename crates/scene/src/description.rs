@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    GuidingMode, IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward,
-    TransmittanceEstimator, VelocityUnit,
+    IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward, TransmittanceEstimator,
+    VelocityUnit,
 };
 use serde::Deserialize;
 
@@ -92,14 +92,6 @@ declare_settings! {
     /// (Mitsuba-like), or whichever a probe of the scene finds cheaper.
     majorant: MajorantMode, flag(long, value_enum), default(MajorantMode::default()),
         example(MajorantMode::Global);
-    /// Path guiding: learn where the light comes from (a radiance cache
-    /// trained on the frame's own paths); `on` plays roulette with paths
-    /// headed for the dark and splits those reaching the light,
-    /// `directions` also scatters toward the learned light, `distances`
-    /// also decides collisions by the learned light ahead; `auto` guides
-    /// where that pays, which measured is nowhere yet.
-    guiding: GuidingMode, flag(long, value_enum), default(GuidingMode::default()),
-        example(GuidingMode::On);
     /// Next-event estimation at each scattering vertex: a shadow ray to
     /// one light picked by its in-scattered light there seen through the
     /// media (a coarse shadow grid; half the shadow rays under a sun and a

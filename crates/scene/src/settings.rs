@@ -50,7 +50,6 @@ impl SceneSettings {
             integrator: r.integrator(),
             transmittance: r.transmittance(),
             majorant: r.majorant(),
-            guiding: r.guiding(),
             light_sampling: r.light_sampling(),
             sunward: r.sunward(),
             budget,

@@ -41,9 +41,9 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::light_grid::Seen;
-use crate::guiding::luminance;
 use crate::light::Lights;
 use crate::phase::Phase;
+use crate::spectrum::luminance;
 
 /// How many lights next-event estimation samples at each vertex.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

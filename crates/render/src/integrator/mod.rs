@@ -12,8 +12,6 @@ mod light_grid;
 mod march;
 mod path;
 mod path_light;
-mod path_scatter;
-mod path_split;
 mod path_sunward;
 mod raymarch;
 mod raymarch2pass;

@@ -1,17 +1,14 @@
 //! Volumetric path tracing: the path loop (`path.rs`), next-event
-//! estimation (`path_light.rs`), the scattered direction, guided or not
-//! (`path_scatter.rs`), and sunward scattering (`path_sunward.rs`).
+//! estimation (`path_light.rs`) and sunward scattering (`path_sunward.rs`).
 
 use glam::Vec3;
 
 use super::light_choice::{LightChoice, LightSampling};
 use super::light_grid::{LightGrid, Seen};
 use super::path_light::Vertex;
-use super::path_split::{At, Pending};
 use super::path_sunward::{Arrival, Sunward};
 use super::{escaped_radiance, AovSample, CameraSampler, LightParts, Sample};
 use crate::compositing::{tag, GroupRadiance, LightGroup};
-use crate::guiding::{Guide, Ignore, Learner};
 use crate::light::Lights;
 use crate::medium::{Interaction, Media};
 use crate::phase::Phase;
@@ -19,9 +16,7 @@ use crate::ray::Ray;
 use crate::sampling::{Draw, Rng, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::stats::Counters;
-use crate::tracking::{
-    sample_free_flight, sample_guided_free_flight, FreeFlight, TransmittanceEstimator,
-};
+use crate::tracking::{sample_free_flight, FreeFlight, TransmittanceEstimator};
 
 /// Russian roulette on path throughput starts after this many scattering
 /// events...
@@ -68,12 +63,8 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   directions, shadow rays' first optical depths, phase direction and
 ///   roulette as the [`Draw`]s of [`crate::sampling`]'s allocation
 ///   (Sobol points for the first vertices); the rest from the hashed stream.
-/// - Guiding: with a [`Guide`], each scattering vertex may play roulette
-///   or split against the learned in-scattered light (`path_split.rs`;
-///   render passes only, a training path is one chain), and its direction
-///   may be drawn from the mixture of the phase function and the learned
-///   product (`path_scatter.rs`), whose density NEE's MIS weights and
-///   escaped light's take. Without one, the phase function alone.
+/// - Directions: the phase function's, sampled exactly (its density is
+///   its value), so NEE's MIS weights and escaped light's take it.
 /// - Sunward scattering ([`Sunward`], `path_sunward.rs`): at a vertex
 ///   with a forward-peaked phase function under a sun, a second direction
 ///   drawn from the phase lobe about the sun gathers the sun's light at
@@ -96,7 +87,6 @@ pub struct PathTracer<'a, M> {
     /// Tag contributions with their light groups (off: `Sample::groups`
     /// stays zero and costs nothing).
     light_groups: bool,
-    guide: Option<&'a Guide>,
     pub(super) light_sampling: LightSampling,
     /// Where the next vertex's sunlight is gathered by sunward scattering
     /// as well ([`Sunward`]).
@@ -122,7 +112,6 @@ impl<'a, M: Media> PathTracer<'a, M> {
             max_depth,
             chromatic: medium.chromatic(),
             light_groups: false,
-            guide: None,
             sunward: Sunward::default(),
             shadows: None,
         }
@@ -195,28 +184,6 @@ impl<'a, M: Media> PathTracer<'a, M> {
     pub fn with_sunward(self, sunward: Sunward) -> Self {
         Self { sunward, ..self }
     }
-
-    /// Follows `guide` where it has learned.
-    pub fn with_guide(self, guide: Option<&'a Guide>) -> Self {
-        Self { guide, ..self }
-    }
-
-    /// One camera sample guided by `guide` (instead of the tracer's own),
-    /// its path reported to `learner`: what training passes render.
-    pub fn sample_with(
-        &self,
-        guide: Option<&Guide>,
-        camera_ray: Ray,
-        draws: &mut SampleStream,
-        c: &mut Counters,
-        learner: &mut impl Learner,
-    ) -> Sample {
-        if self.chromatic {
-            self.trace::<Vec3>(guide, camera_ray, draws, c, learner)
-        } else {
-            self.trace::<f32>(guide, camera_ray, draws, c, learner)
-        }
-    }
 }
 
 impl<M: Media> CameraSampler for PathTracer<'_, M> {
@@ -228,7 +195,11 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
     }
 
     fn sample_stream(&self, camera_ray: Ray, draws: &mut SampleStream, c: &mut Counters) -> Sample {
-        self.sample_with(self.guide, camera_ray, draws, c, &mut Ignore)
+        if self.chromatic {
+            self.trace::<Vec3>(camera_ray, draws, c)
+        } else {
+            self.trace::<f32>(camera_ray, draws, c)
+        }
     }
 }
 
@@ -241,6 +212,15 @@ enum Escape {
     /// heuristic): a phase-sampled ray, with the density it had and the
     /// lights' pick probabilities at its vertex.
     Mis(f32, LightChoice),
+}
+
+/// A scattering vertex, before its next-event estimation and direction.
+#[derive(Clone, Copy)]
+pub(super) struct At<'m> {
+    pub p: Vec3,
+    pub phase: &'m Phase,
+    /// The vertex's index in the draw allocation.
+    pub vertex: u32,
 }
 
 /// A camera path as it is traced: what it carries and what it has found.
@@ -256,10 +236,6 @@ pub(super) struct Path {
     /// the path goes on only to find emitted light, lights at infinity
     /// having had their full weight from next-event estimation.
     emission_only: bool,
-    /// What the path is expected to bring, learned at its first
-    /// scattering vertex: the centre of its roulette and splitting weight
-    /// window (0 until then, or where nothing was learned).
-    pub(super) expected: f32,
     /// How the current ray's direction was drawn.
     pub(super) arrival: Arrival,
     pub(super) out: Sample,
@@ -267,17 +243,10 @@ pub(super) struct Path {
 
 impl Path {
     /// Adds light `parts` reaching the path (throughput included in
-    /// `total`), to the pixel, its light groups and the learner.
+    /// `total`), to the pixel and its light groups.
     #[inline]
-    fn add(
-        &mut self,
-        total: Vec3,
-        parts: Option<LightParts>,
-        groups: bool,
-        learner: &mut impl Learner,
-    ) {
+    fn add(&mut self, total: Vec3, parts: Option<LightParts>, groups: bool) {
         self.out.radiance += total;
-        learner.contribute(total);
         if groups {
             if let Some(parts) = parts {
                 parts.scaled(self.beta).tag(&mut self.out.groups);
@@ -288,9 +257,8 @@ impl Path {
     /// Adds sunlight `e` (throughput included) gathered beside the path's
     /// own vertices.
     #[inline]
-    fn add_sun(&mut self, e: Vec3, groups: bool, learner: &mut impl Learner) {
+    fn add_sun(&mut self, e: Vec3, groups: bool) {
         self.out.radiance += e;
-        learner.contribute(e);
         if groups {
             tag(&mut self.out.groups, LightGroup::Sun, e);
         }
@@ -298,14 +266,12 @@ impl Path {
 }
 
 impl<M: Media> PathTracer<'_, M> {
-    /// One camera path, tracked per channel of `S`.
+    /// One camera path, tracked per channel of `S`, until it ends.
     fn trace<S: Spectrum>(
         &self,
-        guide: Option<&Guide>,
         camera_ray: Ray,
         draws: &mut SampleStream,
         c: &mut Counters,
-        learner: &mut impl Learner,
     ) -> Sample {
         c.paths += 1;
         let mut path = Path {
@@ -314,7 +280,6 @@ impl<M: Media> PathTracer<'_, M> {
             depth: 0,
             escape: Escape::Full,
             emission_only: false,
-            expected: 0.0,
             arrival: Arrival::default(),
             out: Sample {
                 radiance: Vec3::ZERO,
@@ -323,108 +288,40 @@ impl<M: Media> PathTracer<'_, M> {
                 groups: GroupRadiance::default(),
             },
         };
-        let mut pending = Pending::default();
-        self.walk::<S, _>(&mut path, guide, None, draws, c, learner, &mut pending);
-        // The copies a split left, each with its own numbers.
-        while let Some(branch) = pending.pop() {
-            let out = std::mem::take(&mut path.out);
-            path = branch.path;
-            path.out = out;
-            let mut stream = branch.stream;
-            self.walk::<S, _>(
-                &mut path,
-                guide,
-                Some(branch.at),
-                &mut stream,
-                c,
-                learner,
-                &mut pending,
-            );
+        loop {
+            // This free flight and the events at its collision are path
+            // vertex `path.depth` of the draw allocation.
+            let vertex = path.depth;
+            let ray = path.ray;
+            let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
+                sample_free_flight::<S, M>(self.medium, &ray, ray.t_max, &mut path.beta, rng, c)
+            });
+            if path.depth == 0 {
+                path.out.alpha = match flight {
+                    FreeFlight::Escaped => S::escaped_alpha(path.beta),
+                    _ => 1.0,
+                };
+            }
+            let t = match flight {
+                FreeFlight::Escaped => {
+                    self.escape(&mut path, c);
+                    break;
+                }
+                FreeFlight::Capped => break,
+                FreeFlight::Collision { t } => t,
+            };
+            let Some(at) = self.collide::<S>(&mut path, t, vertex, draws, c) else {
+                break;
+            };
+            if !self.scatter_from::<S>(&mut path, &at, draws, c) {
+                break;
+            }
         }
-        learner.finish();
         path.out
     }
 
-    /// Follows one branch of a path until it ends: from its camera ray,
-    /// or from scattering vertex `start` a split left it at. The copies it
-    /// splits into go to `pending`.
-    #[allow(clippy::too_many_arguments)]
-    fn walk<'m, S: Spectrum, L: Learner>(
-        &'m self,
-        path: &mut Path,
-        guide: Option<&Guide>,
-        mut start: Option<At<'m>>,
-        draws: &mut SampleStream,
-        c: &mut Counters,
-        learner: &mut L,
-        pending: &mut Pending<'m>,
-    ) {
-        loop {
-            let at = match start.take() {
-                Some(at) => at,
-                None => {
-                    // This free flight and the events at its collision are
-                    // path vertex `path.depth` of the draw allocation.
-                    let vertex = path.depth;
-                    let ray = path.ray;
-                    // Spectral tracking's flights stay unguided.
-                    let guided = guide.filter(|g| g.decisions().distances && !S::CHROMATIC);
-                    let flight = draws.leading(Draw::FreeFlight, vertex, |rng| match guided {
-                        Some(g) => sample_guided_free_flight(
-                            self.medium,
-                            &ray,
-                            ray.t_max,
-                            &mut path.beta,
-                            rng,
-                            c,
-                            g.collision_worth_along(ray.dir),
-                        ),
-                        None => sample_free_flight::<S, M>(
-                            self.medium,
-                            &ray,
-                            ray.t_max,
-                            &mut path.beta,
-                            rng,
-                            c,
-                        ),
-                    });
-                    if path.depth == 0 {
-                        path.out.alpha = match flight {
-                            // A guided escape's weight estimates the
-                            // transmittance, as spectral tracking's does.
-                            FreeFlight::Escaped if guided.is_some() => {
-                                Vec3::escaped_alpha(path.beta)
-                            }
-                            FreeFlight::Escaped => S::escaped_alpha(path.beta),
-                            _ => 1.0,
-                        };
-                    }
-                    let t = match flight {
-                        FreeFlight::Escaped => return self.escape(path, c, learner),
-                        FreeFlight::Capped => return,
-                        FreeFlight::Collision { t } => t,
-                    };
-                    match self.collide::<S>(path, t, vertex, draws, c, learner) {
-                        Some(at) => at,
-                        None => return,
-                    }
-                }
-            };
-            if !L::LEARNS {
-                let copies = self.weight_window(path, guide, &at, pending, draws, c);
-                pending.split(path, &at, copies, draws);
-                if copies == 0 {
-                    return;
-                }
-            }
-            if !self.scatter_from::<S>(path, guide, &at, draws, c, learner) {
-                return;
-            }
-        }
-    }
-
     /// The path left the media: the lights at infinity it reaches.
-    fn escape(&self, path: &mut Path, c: &mut Counters, learner: &mut impl Learner) {
+    fn escape(&self, path: &mut Path, c: &mut Counters) {
         // A camera ray ended by a depth holdout: what lies behind the
         // held-out geometry, the sky included, never shows.
         let pdf = match path.escape {
@@ -434,7 +331,7 @@ impl<M: Media> PathTracer<'_, M> {
         };
         let parts = escaped_radiance(&self.lights, path.ray.dir, pdf, c);
         let e = path.beta * parts.total();
-        path.add(e, Some(parts), self.light_groups, learner);
+        path.add(e, Some(parts), self.light_groups);
         if path.depth == 1 {
             path.out.aov.direct += e;
         }
@@ -450,7 +347,6 @@ impl<M: Media> PathTracer<'_, M> {
         vertex: u32,
         draws: &mut SampleStream,
         c: &mut Counters,
-        learner: &mut impl Learner,
     ) -> Option<At<'m>> {
         let p = path.ray.at(t);
         let it = self.medium.interaction(p, path.ray.time, draws.rng());
@@ -469,7 +365,7 @@ impl<M: Media> PathTracer<'_, M> {
             aov.instance = Some(it.instance);
         }
         if self.medium.emits() {
-            self.emit(path, p, &it, c, learner);
+            self.emit(path, p, &it, c);
         }
         if self.max_depth == Some(path.depth) {
             return None;
@@ -492,36 +388,26 @@ impl<M: Media> PathTracer<'_, M> {
     fn scatter_from<S: Spectrum>(
         &self,
         path: &mut Path,
-        guide: Option<&Guide>,
         at: &At,
         draws: &mut SampleStream,
         c: &mut Counters,
-        learner: &mut impl Learner,
     ) -> bool {
         let (p, vertex) = (at.p, at.vertex);
         let last = self.max_depth == Some(path.depth);
-        let site = guide.map(|g| (g, g.site_of(p)));
         let ray_in = path.ray;
-        // A guided vertex draws from the product of its learned light and
-        // its phase function (built once: NEE weighs against it too).
-        let product = site
-            .and_then(|(g, site)| g.light(site))
-            .and_then(|l| l.product(|d| at.phase.eval(ray_in.dir, d)));
-        let light = product.as_ref();
         let seen = self.seen(at.phase, p, ray_in.dir);
         let v = Vertex {
             p,
             ray_in: &ray_in,
             phase: at.phase,
             mis: !last,
-            guide: light,
             index: vertex,
             choice: self.light_choice(at.phase, ray_in.dir, seen),
             arrival: path.arrival,
         };
         let parts = self.direct_light::<S>(&v, draws, c);
         let direct = path.beta * parts.total();
-        path.add(direct, Some(parts), self.light_groups, learner);
+        path.add(direct, Some(parts), self.light_groups);
         if path.depth == 1 {
             path.out.aov.direct += direct;
         }
@@ -533,42 +419,29 @@ impl<M: Media> PathTracer<'_, M> {
         }
         // The sunward strategy gathers the next vertex's sunlight beside
         // the continuation (`path_sunward.rs`).
-        let guided_directions = guide.is_some_and(|g| g.decisions().directions);
-        let lobe = self.sunward_lobe(path, at, ray_in.dir, guided_directions, seen);
+        let lobe = self.sunward_lobe(path, at, ray_in.dir, seen);
         if let Some(lobe) = &lobe {
             let e = self.sunward::<S>(path, at, lobe, &ray_in, draws, c);
-            path.add_sun(e, self.light_groups, learner);
+            path.add_sun(e, self.light_groups);
         }
-        let s = self.scatter(&ray_in, at.phase, light, vertex, draws);
-        if light.is_some() {
-            path.beta *= s.weight;
-        }
+        // The phase function is sampled exactly: the direction's weight
+        // `f / pdf` is 1, and its density is `f`.
+        let (u1, u2) = draws.get_2d(Draw::Phase, vertex);
+        let (dir, pdf) = at.phase.sample(ray_in.dir, u1, u2);
         path.arrival = Arrival {
-            scatter_pdf: s.pdf,
-            // Without a guided product the continuation's density is the
-            // phase function's.
-            sunward_pdf: lobe.map_or(0.0, |l| self.sunward_pdf(&l, s.dir, s.pdf)),
+            scatter_pdf: pdf,
+            sunward_pdf: lobe.map_or(0.0, |l| self.sunward_pdf(&l, dir, pdf)),
         };
-        path.escape = Escape::Mis(s.pdf, v.choice);
-        path.ray = ray_in.spawn(p, s.dir);
-        if let Some((_, site)) = site {
-            learner.scatter(site, s.dir, s.weight, path.beta, parts.total());
-        }
+        path.escape = Escape::Mis(pdf, v.choice);
+        path.ray = ray_in.spawn(p, dir);
         self.roulette(path, vertex, draws)
     }
 
     /// `beta * (1 - albedo) * Le`: the emission term at a collision.
-    fn emit(
-        &self,
-        path: &mut Path,
-        p: Vec3,
-        it: &Interaction,
-        c: &mut Counters,
-        learner: &mut impl Learner,
-    ) {
+    fn emit(&self, path: &mut Path, p: Vec3, it: &Interaction, c: &mut Counters) {
         let le = self.medium.emission(p, path.ray.time, it.instance, c);
         let e = path.beta * (Vec3::ONE - it.albedo) * le;
-        path.add(e, None, false, learner);
+        path.add(e, None, false);
         path.out.aov.emission += e;
         if self.light_groups {
             tag(&mut path.out.groups, LightGroup::Emission, e);

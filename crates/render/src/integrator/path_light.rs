@@ -7,10 +7,8 @@ use glam::Vec3;
 
 use super::light_choice::LightChoice;
 use super::path::PathTracer;
-use super::path_scatter::mixture_pdf;
 use super::path_sunward::Arrival;
 use super::LightParts;
-use crate::guiding::BinDistribution;
 use crate::light::{Environment, LightSample};
 use crate::medium::Media;
 use crate::phase::Phase;
@@ -29,9 +27,6 @@ pub(super) struct Vertex<'a> {
     /// Weight against the scattered direction (false at the last allowed
     /// vertex, whose continuation is not traced).
     pub mis: bool,
-    /// The learned light a guided vertex's direction is partly drawn
-    /// from: the scattered direction's density is then the mixture's.
-    pub guide: Option<&'a BinDistribution>,
     /// The vertex's index in the draw allocation.
     pub index: u32,
     /// The probability that each light is sampled here.
@@ -119,8 +114,7 @@ impl<M: Media> PathTracer<'_, M> {
                 let light_pdf = pick * light_pdf;
                 // Every phase function is sampled exactly: its pdf is f.
                 let w = if v.mis {
-                    let scatter_pdf = v.guide.map_or(f, |g| mixture_pdf(f, g.pdf(s.to_light)));
-                    power_heuristic(light_pdf, scatter_pdf)
+                    power_heuristic(light_pdf, f)
                 } else {
                     1.0
                 };

@@ -12,14 +12,12 @@
 //! ([`Spectrum::roulette`]).
 
 mod delta;
-mod guided;
 mod ratio;
 mod residual;
 mod track_length;
 mod walk;
 
 pub use delta::{sample_free_flight, FreeFlight};
-pub use guided::sample_guided_free_flight;
 pub use ratio::ratio_tracking;
 pub use residual::residual_ratio_tracking;
 pub use track_length::track_length_transmittance;
