@@ -72,6 +72,11 @@ impl Sun {
 
     /// A delta light cannot be hit by a sampled direction, so it gets
     /// next-event estimation only and no MIS.
+    /// The disc's solid angle (0 for a delta light).
+    pub fn solid_angle(&self) -> f32 {
+        self.solid_angle
+    }
+
     pub fn is_delta(&self) -> bool {
         self.solid_angle <= 0.0
     }

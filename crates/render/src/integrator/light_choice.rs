@@ -95,6 +95,33 @@ pub const TRACE_FRACTION: f32 = 0.3;
 /// at most 20x.
 pub const MIN_TRACE: f32 = 0.05;
 
+/// The sun's pick probability is at least `DISC_MIS * sqrt(f * solid_angle)`
+/// where the vertex's phase function toward it is `f`, for a sun with a
+/// disc. A phase-sampled ray escaping into the disc carries the disc's
+/// radiance `E / solid_angle` times its power-heuristic weight against
+/// next-event estimation, `f^2 / (f^2 + (pick / solid_angle)^2)`, at most
+/// `(f solid_angle / pick)^2`; with the floor, that is at most
+/// `f E / DISC_MIS^2`, a quarter of the sun's unoccluded next-event value.
+/// Without it, a vertex that the shadow grid takes for dark picks the sun
+/// rarely, and the rare phase-sampled escape into a 0.5 degree disc (its
+/// radiance the irradiance over 7e-5 sr), behind the narrow forward peak
+/// of a Mie phase function, carried a back-lit cloud's light in single
+/// samples of thousands. Under Henyey-Greenstein g 0.8 the floor is at
+/// most 0.03 (a delta sun, which no ray can hit, has none), so a thick
+/// cloud keeps most of its skipped shadow rays.
+pub const DISC_MIS: f32 = 2.0;
+
+/// [`DISC_MIS`]'s floor for a sun of `solid_angle` seen with phase `f`.
+#[inline]
+pub fn disc_floor(f: f32, solid_angle: f32) -> f32 {
+    let floor = DISC_MIS * (f * solid_angle).sqrt();
+    if floor.is_finite() {
+        floor.min(1.0)
+    } else {
+        1.0
+    }
+}
+
 /// The probability that a vertex's next-event estimation samples each
 /// light (1 for both under `all`: each light is sampled once).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -134,6 +161,7 @@ impl LightChoice {
             sun: p,
             sky: 1.0 - p,
         }
+        .with_disc_floor(lights, f_sun)
     }
 
     /// The pick at a vertex reached along `dir_in` with phase function
@@ -143,9 +171,14 @@ impl LightChoice {
     /// probability, where it sees less than [`TRACE_FRACTION`] of the
     /// unoccluded light.
     pub fn shadowed(lights: &Lights, seen: Seen, phase: &Phase, dir_in: Vec3) -> Self {
-        let sun_open = lights.sun.as_ref().map_or(0.0, |sun| {
-            luminance(sun.irradiance()) * phase.eval(dir_in, -sun.direction())
-        });
+        let f_sun = lights
+            .sun
+            .as_ref()
+            .map_or(0.0, |sun| phase.eval(dir_in, -sun.direction()));
+        let sun_open = lights
+            .sun
+            .as_ref()
+            .map_or(0.0, |sun| luminance(sun.irradiance()) * f_sun);
         let sky_open = lights
             .environment
             .as_ref()
@@ -174,6 +207,35 @@ impl LightChoice {
             sun: trace * p_sun,
             sky: trace * (1.0 - p_sun),
         }
+        .with_disc_floor(lights, f_sun)
+    }
+
+    /// The pick with the sun's probability raised to
+    /// [`disc_floor`] where its disc would otherwise be left to phase
+    /// sampling (the sky's probability unchanged: where the two then sum
+    /// past one, a vertex sometimes samples both).
+    fn with_disc_floor(self, lights: &Lights, f_sun: f32) -> Self {
+        let floor = lights
+            .sun
+            .as_ref()
+            .map_or(0.0, |sun| disc_floor(f_sun, sun.solid_angle()));
+        LightChoice {
+            sun: self.sun.max(floor),
+            ..self
+        }
+    }
+
+    /// Which lights a vertex samples, from one uniform number `u`: the sun
+    /// below `sun`, the sky over the next `sky` of the unit interval,
+    /// wrapping around to its start where the two sum past one (so each
+    /// is sampled with exactly its probability, and never both while they
+    /// sum to one or less).
+    #[inline]
+    pub fn picks(self, u: f32) -> (bool, bool) {
+        let sun = u < self.sun;
+        let end = self.sun + self.sky;
+        let sky = (u >= self.sun && u < end) || u < end - 1.0;
+        (sun, sky)
     }
 
     /// Whether this samples every light (no pick to draw).
@@ -224,6 +286,70 @@ mod tests {
         let toward = LightChoice::at(LightSampling::One, &l, &phase, Vec3::Y);
         assert!(away.sun < 0.1, "{away:?}");
         assert_eq!(toward.sun, 1.0 - MIN_PROBABILITY);
+    }
+
+    /// With the floor, a phase-sampled ray escaping into the sun's disc
+    /// never carries more than `f E / DISC_MIS^2` (its radiance times its
+    /// power-heuristic weight), at any phase value and disc size; a delta
+    /// sun has no floor.
+    #[test]
+    fn an_escape_into_the_disc_carries_at_most_a_quarter_of_the_suns_value() {
+        for degrees in [0.1f32, 0.53, 2.0, 10.0] {
+            let sun = Sun::new(Vec3::NEG_Y, Vec3::ONE, degrees.to_radians());
+            let omega = sun.solid_angle();
+            for f in [0.01f32, 0.3, 3.6, 100.0, 2700.0, 1e6] {
+                let pick = disc_floor(f, omega);
+                assert!(pick > 0.0 && pick <= 1.0, "{degrees} deg, f {f}: {pick}");
+                let w = crate::sampling::power_heuristic(f, pick / omega);
+                let carried = w / omega;
+                assert!(
+                    carried <= f / (DISC_MIS * DISC_MIS) * 1.0001 || pick == 1.0,
+                    "{degrees} deg, f {f}: pick {pick} carries {carried}"
+                );
+            }
+        }
+        let delta = Sun::new(Vec3::NEG_Y, Vec3::ONE, 0.0);
+        assert_eq!(disc_floor(2700.0, delta.solid_angle()), 0.0);
+    }
+
+    /// One uniform number picks each light with exactly its probability,
+    /// and both only where the probabilities sum past one.
+    #[test]
+    fn a_pick_samples_each_light_with_its_probability() {
+        for (sun, sky) in [
+            (0.3f32, 0.5f32),
+            (0.05, 0.0025),
+            (0.8, 0.6),
+            (1.0, 0.2),
+            (0.0, 0.7),
+        ] {
+            let choice = LightChoice { sun, sky };
+            let n = 100_000;
+            let (mut suns, mut skies, mut both) = (0, 0, 0);
+            for i in 0..n {
+                let (a, b) = choice.picks((i as f32 + 0.5) / n as f32);
+                suns += u32::from(a);
+                skies += u32::from(b);
+                both += u32::from(a && b);
+            }
+            let frac = |k: u32| k as f32 / n as f32;
+            assert!(
+                (frac(suns) - sun).abs() < 1e-4,
+                "{choice:?}: sun {}",
+                frac(suns)
+            );
+            assert!(
+                (frac(skies) - sky).abs() < 1e-4,
+                "{choice:?}: sky {}",
+                frac(skies)
+            );
+            let overlap = (sun + sky - 1.0).max(0.0);
+            assert!(
+                (frac(both) - overlap).abs() < 1e-4,
+                "{choice:?}: both {}",
+                frac(both)
+            );
+        }
     }
 
     #[test]

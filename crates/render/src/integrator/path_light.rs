@@ -50,10 +50,8 @@ impl<M: Media> PathTracer<'_, M> {
             (true, true)
         } else {
             // Sun, sky, or (where the choice traces no shadow ray with the
-            // remaining probability) neither.
-            let u = draws.rng().uniform();
-            let sun = u < v.choice.sun;
-            (sun, !sun && u < v.choice.sun + v.choice.sky)
+            // remaining probability) neither; both where they sum past one.
+            v.choice.picks(draws.rng().uniform())
         };
         let mut l = LightParts::default();
         if let Some(sun) = self.lights.sun.as_ref().filter(|_| sun_picked) {
