@@ -12,16 +12,19 @@ mod light_grid;
 mod march;
 mod path;
 mod path_light;
+mod path_state;
 mod path_sunward;
 mod raymarch;
 mod raymarch2pass;
+mod sunward_mode;
 
 pub use light_choice::LightSampling;
 pub use light_grid::{LightGrid, LightGridSettings};
 pub use path::PathTracer;
-pub use path_sunward::{Sunward, FORWARD_MEAN_COSINE, KEEP_THRESHOLD};
+pub use path_sunward::KEEP_THRESHOLD;
 pub use raymarch::RayMarcher;
 pub use raymarch2pass::TwoPassMarcher;
+pub use sunward_mode::{Sunward, FORWARD_MEAN_COSINE};
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};

@@ -5,9 +5,9 @@ use glam::Vec3;
 
 use super::light_choice::{LightChoice, LightSampling};
 use super::light_grid::{LightGrid, Seen};
-use super::path_light::Vertex;
-use super::path_sunward::{Arrival, Sunward};
-use super::{escaped_radiance, AovSample, CameraSampler, LightParts, Sample};
+use super::path_state::{Arrival, At, Escape, Path, Vertex};
+use super::sunward_mode::Sunward;
+use super::{escaped_radiance, AovSample, CameraSampler, Sample};
 use crate::compositing::{tag, GroupRadiance, LightGroup};
 use crate::light::Lights;
 use crate::medium::{Interaction, Media};
@@ -199,68 +199,6 @@ impl<M: Media> CameraSampler for PathTracer<'_, M> {
             self.trace::<Vec3>(camera_ray, draws, c)
         } else {
             self.trace::<f32>(camera_ray, draws, c)
-        }
-    }
-}
-
-/// What the lights at infinity a ray escapes to add.
-#[derive(Clone, Copy, Debug)]
-enum Escape {
-    /// All their light: the camera ray, which no light strategy sampled.
-    Full,
-    /// Weighted against next-event estimation's samples (power
-    /// heuristic): a phase-sampled ray, with the density it had and the
-    /// lights' pick probabilities at its vertex.
-    Mis(f32, LightChoice),
-}
-
-/// A scattering vertex, before its next-event estimation and direction.
-#[derive(Clone, Copy)]
-pub(super) struct At<'m> {
-    pub p: Vec3,
-    pub phase: &'m Phase,
-    /// The vertex's index in the draw allocation.
-    pub vertex: u32,
-}
-
-/// A camera path as it is traced: what it carries and what it has found.
-#[derive(Clone)]
-pub(super) struct Path {
-    ray: Ray,
-    pub(super) beta: Vec3,
-    /// Scattering events so far.
-    pub(super) depth: u32,
-    /// How the lights at infinity the current ray escapes to count.
-    escape: Escape,
-    /// Set after the last allowed scattering event when the media emit:
-    /// the path goes on only to find emitted light, lights at infinity
-    /// having had their full weight from next-event estimation.
-    emission_only: bool,
-    /// How the current ray's direction was drawn.
-    pub(super) arrival: Arrival,
-    pub(super) out: Sample,
-}
-
-impl Path {
-    /// Adds light `parts` reaching the path (throughput included in
-    /// `total`), to the pixel and its light groups.
-    #[inline]
-    fn add(&mut self, total: Vec3, parts: Option<LightParts>, groups: bool) {
-        self.out.radiance += total;
-        if groups {
-            if let Some(parts) = parts {
-                parts.scaled(self.beta).tag(&mut self.out.groups);
-            }
-        }
-    }
-
-    /// Adds sunlight `e` (throughput included) gathered beside the path's
-    /// own vertices.
-    #[inline]
-    fn add_sun(&mut self, e: Vec3, groups: bool) {
-        self.out.radiance += e;
-        if groups {
-            tag(&mut self.out.groups, LightGroup::Sun, e);
         }
     }
 }

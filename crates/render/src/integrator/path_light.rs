@@ -5,36 +5,15 @@
 
 use glam::Vec3;
 
-use super::light_choice::LightChoice;
 use super::path::PathTracer;
-use super::path_sunward::Arrival;
+use super::path_state::Vertex;
 use super::LightParts;
 use crate::light::{Environment, LightSample};
 use crate::medium::Media;
-use crate::phase::Phase;
-use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Draw, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::stats::Counters;
 use crate::tracking::transmittance;
-
-/// Where and how the light is gathered at a vertex.
-pub(super) struct Vertex<'a> {
-    pub p: Vec3,
-    /// The ray that arrived (its direction and time).
-    pub ray_in: &'a Ray,
-    pub phase: &'a Phase,
-    /// Weight against the scattered direction (false at the last allowed
-    /// vertex, whose continuation is not traced).
-    pub mis: bool,
-    /// The vertex's index in the draw allocation.
-    pub index: u32,
-    /// The probability that each light is sampled here.
-    pub choice: LightChoice,
-    /// How the path arrived here, for the sun's weight against sunward
-    /// scattering at the previous vertex.
-    pub arrival: Arrival,
-}
 
 impl<M: Media> PathTracer<'_, M> {
     /// NEE at a vertex: one sample of the sun and one of the sky, or of

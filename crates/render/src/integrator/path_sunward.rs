@@ -35,17 +35,17 @@
 //! bring nothing back.
 //!
 //! The strategy runs where the next vertex gathers light (not at the last
-//! allowed vertex), under a sun, and, under [`Sunward::Auto`],
+//! allowed vertex), under a sun, and, under [`Sunward::Auto`](super::Sunward::Auto),
 //! at vertices whose phase function is forward-peaked: measured at equal
 //! time on the thick benchmark cloud it pays 0.96x at g 0.5, 1.26x at
 //! 0.65, 1.6x at 0.8 and 2.0x at 0.9.
 
 use glam::Vec3;
-use serde::{Deserialize, Serialize};
 
 use super::light_choice::LightChoice;
 use super::light_grid::Seen;
-use super::path::{At, Path, PathTracer};
+use super::path::PathTracer;
+use super::path_state::{At, Path};
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
@@ -53,44 +53,6 @@ use crate::sampling::{power_heuristic, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::stats::Counters;
 use crate::tracking::{sample_free_flight, transmittance, FreeFlight};
-
-/// Where sunward scattering runs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum Sunward {
-    /// At vertices whose phase function's mean cosine is at least
-    /// [`FORWARD_MEAN_COSINE`].
-    #[default]
-    Auto,
-    /// At every vertex under a sun.
-    On,
-    Off,
-}
-
-impl Sunward {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Auto => "auto",
-            Self::On => "on",
-            Self::Off => "off",
-        }
-    }
-
-    /// Whether the strategy runs at a vertex scattering by `phase`.
-    #[inline]
-    pub fn runs_at(self, phase: &Phase) -> bool {
-        match self {
-            Self::Auto => phase.mean_cosine() >= FORWARD_MEAN_COSINE,
-            Self::On => true,
-            Self::Off => false,
-        }
-    }
-}
-
-/// `auto`'s threshold: between the measured break-even (g 0.5, 0.96x) and
-/// the first gain (g 0.65, 1.26x).
-pub const FORWARD_MEAN_COSINE: f32 = 0.6;
 
 /// A draw whose expected contribution is this many times an isotropic
 /// vertex's is always kept. Measured on the thick benchmark cloud: 2 and 4
@@ -103,31 +65,6 @@ pub const KEEP_THRESHOLD: f32 = 2.0;
 /// cloud at equal time: 0.3 1.03x, 0.1 1.04x, 0.03 1.05-1.06x, 0.01 and
 /// 0.003 1.04x (BENCHMARKS.md, "Sunward scattering").
 pub const LIT_FRACTION: f32 = 0.03;
-
-/// How the direction a path travels along was drawn: what the sun's
-/// next-event estimate at its next vertex weighs itself by.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Arrival {
-    /// The continuation's scattering density of the direction.
-    pub scatter_pdf: f32,
-    /// The sunward strategy's density for it (kept fraction included); 0
-    /// where that strategy did not run (the camera ray included), leaving
-    /// the next-event estimate its whole weight.
-    pub sunward_pdf: f32,
-}
-
-impl Arrival {
-    /// The weight of the sun's next-event estimate at the vertex this
-    /// arrival reaches, where the sun is picked with probability `pick`.
-    #[inline]
-    pub fn sun_weight(self, pick: f32) -> f32 {
-        if self.sunward_pdf > 0.0 {
-            power_heuristic(self.scatter_pdf * pick, self.sunward_pdf)
-        } else {
-            1.0
-        }
-    }
-}
 
 /// The probability that a draw of the sunward lobe (density `q` there) is
 /// kept, where the continuation's density is `f`, the sun's pick at the
@@ -292,6 +229,7 @@ impl<M: Media> PathTracer<'_, M> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::path_state::Arrival;
     use crate::integrator::LightSampling;
     use crate::light::{Environment, Lights, Sun};
     use crate::sampling::Rng;
