@@ -40,6 +40,9 @@
 //! Coordinates are render space: world space minus an offset the caller
 //! picks so that f32 stays precise; lengths keep world units.
 
+#[macro_use]
+mod settings_enum;
+
 pub mod adaptive;
 pub mod blackbody;
 pub mod camera;

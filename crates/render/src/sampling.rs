@@ -52,7 +52,6 @@
 use std::f32::consts::PI;
 
 use glam::Vec3;
-use serde::{Deserialize, Serialize};
 
 use crate::sobol::{OwenSobol, SobolIndex};
 
@@ -129,27 +128,19 @@ impl Rng {
     }
 }
 
-/// Where a camera sample's numbers come from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum SamplerKind {
-    /// Owen-scrambled Sobol points for the draws of the first path
-    /// vertices, the hashed stream for the rest.
-    #[default]
-    Sobol,
-    /// Every number from the hashed stream (independent samples).
-    Random,
-}
-
-impl SamplerKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Sobol => "sobol",
-            Self::Random => "random",
-        }
+settings_enum! {
+    /// Where a camera sample's numbers come from.
+    pub enum SamplerKind {
+        /// Owen-scrambled Sobol points for the draws of the first path
+        /// vertices, the hashed stream for the rest.
+        #[default]
+        Sobol = "sobol",
+        /// Every number from the hashed stream (independent samples).
+        Random = "random",
     }
 }
+
+impl SamplerKind {}
 
 /// Path vertices (free flights, counted from the camera's) whose draws
 /// come from Sobol points; later ones use the hashed stream.

@@ -3,7 +3,6 @@
 
 use std::sync::Arc;
 
-use serde::{Deserialize, Serialize};
 
 use crate::adaptive::Adaptive;
 use crate::camera::Camera;
@@ -26,30 +25,21 @@ pub struct Scene<M> {
     pub lights: Lights,
 }
 
-/// Which majorants the trackers use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum MajorantMode {
-    /// Whichever of the two a probe of the scene finds cheaper
-    /// ([`crate::majorant_choice`]).
-    #[default]
-    Auto,
-    /// The field's own local segments (its hierarchy or grid).
-    Hierarchy,
-    /// One global majorant over the field's bounds (Mitsuba 3 style).
-    Global,
-}
-
-impl MajorantMode {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Auto => "auto",
-            Self::Hierarchy => "hierarchy",
-            Self::Global => "global",
-        }
+settings_enum! {
+    /// Which majorants the trackers use.
+    pub enum MajorantMode {
+        /// Whichever of the two a probe of the scene finds cheaper
+        /// ([`crate::majorant_choice`]).
+        #[default]
+        Auto = "auto",
+        /// The field's own local segments (its hierarchy or grid).
+        Hierarchy = "hierarchy",
+        /// One global majorant over the field's bounds (Mitsuba 3 style).
+        Global = "global",
     }
 }
+
+impl MajorantMode {}
 
 /// How long to render.
 #[derive(Clone, Copy, Debug, PartialEq)]

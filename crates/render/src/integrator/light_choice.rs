@@ -38,38 +38,28 @@
 //! strategies' weights still sum to one.
 
 use glam::Vec3;
-use serde::{Deserialize, Serialize};
 
 use super::light_grid::Seen;
 use crate::light::Lights;
 use crate::phase::Phase;
 use crate::spectrum::luminance;
 
-/// How many lights next-event estimation samples at each vertex.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum LightSampling {
-    /// `one` under a constant sky (with or without a sun), `all` otherwise.
-    #[default]
-    Auto,
-    /// Every light, one sample each.
-    All,
-    /// One light (or, deep in the media, most often none), picked in
-    /// proportion to its in-scattered radiance at the vertex seen through
-    /// the media.
-    One,
+settings_enum! {
+    /// How many lights next-event estimation samples at each vertex.
+    pub enum LightSampling {
+        /// `one` under a constant sky (with or without a sun), `all` otherwise.
+        #[default]
+        Auto = "auto",
+        /// Every light, one sample each.
+        All = "all",
+        /// One light (or, deep in the media, most often none), picked in
+        /// proportion to its in-scattered radiance at the vertex seen through
+        /// the media.
+        One = "one",
+    }
 }
 
 impl LightSampling {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Auto => "auto",
-            Self::All => "all",
-            Self::One => "one",
-        }
-    }
-
     /// What `self` comes to under `lights`: `All` or `One`.
     pub fn resolve(self, lights: &Lights) -> LightSampling {
         match self {

@@ -27,7 +27,6 @@ pub use raymarch2pass::TwoPassMarcher;
 pub use sunward_mode::{Sunward, FORWARD_MEAN_COSINE};
 
 use glam::Vec3;
-use serde::{Deserialize, Serialize};
 
 use crate::compositing::GroupRadiance;
 use crate::light::Lights;
@@ -36,23 +35,17 @@ use crate::sampling::{power_heuristic, Rng, SampleStream};
 use crate::stats::Counters;
 use light_choice::LightChoice;
 
-/// Which integrator renders the image.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum IntegratorKind {
-    /// Unbiased volumetric path tracing (delta tracking, NEE with MIS).
-    #[default]
-    #[serde(rename = "path")]
-    #[cfg_attr(feature = "clap", value(name = "path"))]
-    Path,
-    /// Single scattering by ray marching with jittered steps (biased preview).
-    #[serde(rename = "raymarch")]
-    #[cfg_attr(feature = "clap", value(name = "raymarch"))]
-    RayMarch,
-    /// Two-pass ray marching over a cached light grid (Kajiya and Von Herzen).
-    #[serde(rename = "raymarch2pass")]
-    #[cfg_attr(feature = "clap", value(name = "raymarch2pass"))]
-    RayMarch2Pass,
+settings_enum! {
+    /// Which integrator renders the image.
+    pub enum IntegratorKind {
+        /// Unbiased volumetric path tracing (delta tracking, NEE with MIS).
+        #[default]
+        Path = "path",
+        /// Single scattering by ray marching with jittered steps (biased preview).
+        RayMarch = "raymarch",
+        /// Two-pass ray marching over a cached light grid (Kajiya and Von Herzen).
+        RayMarch2Pass = "raymarch2pass",
+    }
 }
 
 impl IntegratorKind {
@@ -60,14 +53,6 @@ impl IntegratorKind {
     /// density is, not tight majorants).
     pub fn marches(self) -> bool {
         matches!(self, Self::RayMarch | Self::RayMarch2Pass)
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Path => "path",
-            Self::RayMarch => "raymarch",
-            Self::RayMarch2Pass => "raymarch2pass",
-        }
     }
 }
 

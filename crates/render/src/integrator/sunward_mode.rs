@@ -1,33 +1,22 @@
 //! Where the path tracer runs sunward scattering (`path_sunward.rs`): a
 //! setting, apart from the strategy so that the tracer can hold it.
 
-use serde::{Deserialize, Serialize};
-
 use crate::phase::Phase;
 
-/// Where sunward scattering runs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum Sunward {
-    /// At vertices whose phase function's mean cosine is at least
-    /// [`FORWARD_MEAN_COSINE`].
-    #[default]
-    Auto,
-    /// At every vertex under a sun.
-    On,
-    Off,
+settings_enum! {
+    /// Where sunward scattering runs.
+    pub enum Sunward {
+        /// At vertices whose phase function's mean cosine is at least
+        /// [`FORWARD_MEAN_COSINE`].
+        #[default]
+        Auto = "auto",
+        /// At every vertex under a sun.
+        On = "on",
+        Off = "off",
+    }
 }
 
 impl Sunward {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Auto => "auto",
-            Self::On => "on",
-            Self::Off => "off",
-        }
-    }
-
     /// Whether the strategy runs at a vertex scattering by `phase`.
     #[inline]
     pub fn runs_at(self, phase: &Phase) -> bool {

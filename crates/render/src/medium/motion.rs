@@ -12,31 +12,22 @@ use std::sync::Arc;
 
 use cirrus_bricks::{BrickError, BrickVolume, VelocityGrid};
 use glam::{DMat3, DMat4, Mat3, Mat4, Vec3};
-use serde::{Deserialize, Serialize};
 
 use crate::shutter::Shutter;
 
-/// What a velocity value means.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum VelocityUnit {
-    /// World units (of the grid's file, before any instance transform)
-    /// per frame.
-    #[default]
-    World,
-    /// Voxels of the velocity grid per frame.
-    Voxels,
-}
-
-impl VelocityUnit {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::World => "world",
-            Self::Voxels => "voxels",
-        }
+settings_enum! {
+    /// What a velocity value means.
+    pub enum VelocityUnit {
+        /// World units (of the grid's file, before any instance transform)
+        /// per frame.
+        #[default]
+        World = "world",
+        /// Voxels of the velocity grid per frame.
+        Voxels = "voxels",
     }
 }
+
+impl VelocityUnit {}
 
 /// A velocity grid and how its values move a field.
 #[derive(Clone, Debug)]

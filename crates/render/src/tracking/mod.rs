@@ -22,7 +22,6 @@ pub use ratio::ratio_tracking;
 pub use residual::residual_ratio_tracking;
 pub use track_length::track_length_transmittance;
 
-use serde::{Deserialize, Serialize};
 
 use crate::medium::Media;
 use crate::ray::Ray;
@@ -38,36 +37,27 @@ pub const ROULETTE_THRESHOLD: f32 = 0.05;
 /// ...terminating with this probability, else dividing by `1 - q`.
 pub const ROULETTE_Q: f32 = 0.75;
 
-/// How shadow rays estimate transmittance.
-///
-/// Residual ratio tracking is the default: in BENCHMARKS.md it is 1.07x to
-/// 1.17x as efficient as plain ratio tracking over the hierarchy, with less
-/// noise per path than track-length.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum TransmittanceEstimator {
-    /// Ratio tracking (Novak, Selle, Jarosz 2014).
-    Ratio,
-    /// Residual ratio tracking with the segment minorant as control
-    /// (Novak et al. 2014, section 5). Chromatic media take ratio tracking
-    /// instead: the segments' one minorant (of the largest channel summed
-    /// over instances) is no control for each channel.
-    #[default]
-    Residual,
-    /// Track-length estimation: 1 if a delta-tracked flight escapes, else 0.
-    TrackLength,
-}
-
-impl TransmittanceEstimator {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Ratio => "ratio",
-            Self::Residual => "residual",
-            Self::TrackLength => "track-length",
-        }
+settings_enum! {
+    /// How shadow rays estimate transmittance.
+    ///
+    /// Residual ratio tracking is the default: in BENCHMARKS.md it is 1.07x to
+    /// 1.17x as efficient as plain ratio tracking over the hierarchy, with less
+    /// noise per path than track-length.
+    pub enum TransmittanceEstimator {
+        /// Ratio tracking (Novak, Selle, Jarosz 2014).
+        Ratio = "ratio",
+        /// Residual ratio tracking with the segment minorant as control
+        /// (Novak et al. 2014, section 5). Chromatic media take ratio tracking
+        /// instead: the segments' one minorant (of the largest channel summed
+        /// over instances) is no control for each channel.
+        #[default]
+        Residual = "residual",
+        /// Track-length estimation: 1 if a delta-tracked flight escapes, else 0.
+        TrackLength = "track-length",
     }
 }
+
+impl TransmittanceEstimator {}
 
 /// Transmittance along `ray` over `[0, t_max]` by the chosen estimator,
 /// per channel of `S`; counts one shadow ray.
