@@ -65,12 +65,6 @@ impl Error {
     }
 }
 
-impl From<crate::medium::MediumError> for Error {
-    fn from(e: crate::medium::MediumError) -> Self {
-        Self::Invalid(e.to_string())
-    }
-}
-
 /// An error of the `exr` crate reading or writing `path`: its I/O errors
 /// are the file's, everything else is the file's format.
 pub(crate) fn exr_error(path: &Path, e: exr::error::Error) -> Error {

@@ -15,7 +15,9 @@
 
 use std::path::Path;
 
-use crate::error::{exr_error, Error, Result};
+pub use crate::exr_read::{read_channels, ExrChannels};
+
+use crate::error::{Error, Result};
 use crate::film::AovImage;
 use crate::render::Rendered;
 
@@ -185,71 +187,6 @@ fn write_channels(
     })
 }
 
-/// One tile read back: display size, data window and channels.
-struct Tile {
-    full: (usize, usize),
-    position: (i32, i32),
-    size: (usize, usize),
-    channels: Vec<(String, Vec<f32>)>,
-    /// The header's text attributes (the Cryptomatte manifest), sorted.
-    attributes: Vec<(String, String)>,
-}
-
-fn read_tile(path: &Path) -> Result<Tile> {
-    use exr::prelude::*;
-    let err = |e| exr_error(path, e);
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(err)?;
-    let dw = image.attributes.display_window;
-    let layer = image.layer_data;
-    // The exr crate reads a header's unknown attributes into the layer's.
-    let mut attributes: Vec<(String, String)> = layer
-        .attributes
-        .other
-        .iter()
-        .filter_map(|(k, v)| match v {
-            AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
-            _ => None,
-        })
-        .collect();
-    attributes.sort();
-    if dw.position != Vec2(0, 0) {
-        return Err(crate::error::Error::format(
-            path,
-            "display window must start at 0,0",
-        ));
-    }
-    let channels = layer
-        .channel_data
-        .list
-        .into_iter()
-        .map(|c| {
-            let v = match c.sample_data {
-                FlatSamples::F32(v) => v,
-                FlatSamples::F16(v) => v.into_iter().map(|h| h.to_f32()).collect(),
-                FlatSamples::U32(v) => v.into_iter().map(|u| u as f32).collect(),
-            };
-            (c.name.to_string(), v)
-        })
-        .collect();
-    Ok(Tile {
-        full: (dw.size.0, dw.size.1),
-        position: (
-            layer.attributes.layer_position.0,
-            layer.attributes.layer_position.1,
-        ),
-        size: (layer.size.0, layer.size.1),
-        channels,
-        attributes,
-    })
-}
-
 /// Assembles crop tiles into one full-size EXR. The tiles must share the
 /// display window and channel names, lie inside the image, not overlap,
 /// and cover it exactly; any violation is an error naming the file.
@@ -257,7 +194,7 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
     let first = tiles
         .first()
         .ok_or_else(|| Error::invalid("no tiles to merge"))?;
-    let t0 = read_tile(first)?;
+    let t0 = read_channels(first)?;
     let (fw, fh) = t0.full;
     let names: Vec<String> = t0.channels.iter().map(|(n, _)| n.clone()).collect();
     let attributes = t0.attributes.clone();
@@ -265,13 +202,13 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
     let mut covered = vec![false; fw * fh];
     for (k, path) in tiles.iter().enumerate() {
         let t = if k == 0 {
-            Tile {
+            ExrChannels {
                 channels: t0.channels.clone(),
                 attributes: t0.attributes.clone(),
                 ..t0
             }
         } else {
-            read_tile(path)?
+            read_channels(path)?
         };
         let misfit = |message: String| Error::format(path, message);
         if t.full != (fw, fh) {
@@ -331,28 +268,4 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
         attributes,
     )
     .map_err(|e| Error::io(out, e))
-}
-
-/// Every channel of an EXR's first layer over its data window, by name,
-/// with the window's position and size (for tests and tools).
-pub fn read_channels(path: &Path) -> Result<ExrChannels> {
-    let t = read_tile(path)?;
-    Ok(ExrChannels {
-        full: t.full,
-        position: t.position,
-        size: t.size,
-        channels: t.channels,
-        attributes: t.attributes,
-    })
-}
-
-/// What [`read_channels`] returns.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ExrChannels {
-    pub full: (usize, usize),
-    pub position: (i32, i32),
-    pub size: (usize, usize),
-    pub channels: Vec<(String, Vec<f32>)>,
-    /// The header's text attributes, sorted by name.
-    pub attributes: Vec<(String, String)>,
 }

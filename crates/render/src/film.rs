@@ -92,9 +92,7 @@ pub struct AovImage {
     pub samples: Vec<f32>,
 }
 
-/// Depth of a pixel no camera sample collided in (Blender's convention
-/// for the background of its Z pass).
-pub const NO_DEPTH: f32 = 1e10;
+pub use crate::compositing::deep::NO_DEPTH;
 
 /// Running means of the AOV parts of one pixel's samples.
 #[derive(Clone, Copy, Debug, Default)]

@@ -53,6 +53,7 @@ pub mod distribution;
 pub mod env_map;
 pub mod error;
 pub mod exr_layers;
+mod exr_read;
 pub mod film;
 pub mod image_io;
 pub mod integrator;

@@ -3,7 +3,6 @@
 
 use std::sync::Arc;
 
-
 use crate::adaptive::Adaptive;
 use crate::camera::Camera;
 use crate::compositing::Compositing;

@@ -21,7 +21,7 @@ use crate::medium::{MajorantSegment, Media};
 use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::stats::Counters;
-use crate::tracking::{ROULETTE_Q, ROULETTE_THRESHOLD};
+use crate::tracking::roulette::{ROULETTE_Q, ROULETTE_THRESHOLD};
 
 /// What a free flight's tentative collision turned out to be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -18,7 +18,7 @@ use glam::{DMat4, DVec3, Vec3};
 
 use crate::description::{SceneDescription, VolumeSpec};
 use crate::error::{Error, Result};
-use crate::plan::{Plan, VolumeCache};
+use crate::plan::{Plan, Pose, VolumeCache};
 use crate::settings::SceneSettings;
 use crate::timeline::{camera_placement, frame_of, lens_fov, matrix_at};
 
@@ -98,10 +98,6 @@ pub fn shell(
         .motion_shell(reach)
         .map_err(|e| Error::input(format!("moving volume: {e}")))
 }
-
-/// A moving volume's pose table and the shell of bricks bounding its
-/// density over every pose.
-pub type Pose = (Arc<PoseTable>, BrickVolume);
 
 /// Per kept plan, the pose table and shell of the moving ones (their
 /// grids loaded).

@@ -24,6 +24,10 @@ use crate::grids::{
     read_velocity,
 };
 
+/// A moving volume's pose table and the shell of bricks bounding its
+/// density over every pose.
+pub type Pose = (Arc<cirrus_render::transform_motion::PoseTable>, BrickVolume);
+
 /// One volume's plan: where its grids are and how it is placed.
 pub struct Plan {
     pub file: PathBuf,
@@ -232,7 +236,7 @@ pub struct VolumeCache {
     cbrk_bytes: u64,
     /// The pose tables and shells of the last prepared scene's moving
     /// volumes, per kept volume (`moving.rs`).
-    pub(crate) poses: Vec<Option<crate::moving::Pose>>,
+    pub(crate) poses: Vec<Option<Pose>>,
 }
 
 /// A grid of a file as it is stored: file, grid index, precision.

@@ -38,7 +38,10 @@
 
 use glam::Vec3;
 
-use crate::film::NO_DEPTH;
+/// Depth of a pixel no camera sample collided in (Blender's convention
+/// for the background of its Z pass), in the film's depth pass and the
+/// deep image's background sample alike.
+pub const NO_DEPTH: f32 = 1e10;
 
 /// Bins a pixel keeps while sampling.
 pub const RAW_BINS: usize = 64;

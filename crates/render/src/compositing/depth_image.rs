@@ -72,7 +72,7 @@ impl DepthHoldout {
                 display.size.0, display.size.1, size.0, size.1
             )));
         }
-        let image = crate::exr_layers::read_channels(path)?;
+        let image = crate::exr_read::read_channels(path)?;
         let names: Vec<&str> = image.channels.iter().map(|(n, _)| n.as_str()).collect();
         let chosen = match channel {
             Some(c) => names

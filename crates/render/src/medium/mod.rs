@@ -136,6 +136,12 @@ pub enum MediumError {
     Albedo(Vec3),
 }
 
+impl From<MediumError> for crate::error::Error {
+    fn from(e: MediumError) -> Self {
+        Self::Invalid(e.to_string())
+    }
+}
+
 /// Extinction per unit density and RGB channel, split into what the
 /// trackers need: the largest channel's scale (what majorants are scaled
 /// by) and each channel's share of it.

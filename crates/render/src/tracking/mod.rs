@@ -14,6 +14,7 @@
 mod delta;
 mod ratio;
 mod residual;
+pub(crate) mod roulette;
 mod track_length;
 mod walk;
 
@@ -21,7 +22,6 @@ pub use delta::{sample_free_flight, FreeFlight};
 pub use ratio::ratio_tracking;
 pub use residual::residual_ratio_tracking;
 pub use track_length::track_length_transmittance;
-
 
 use crate::medium::Media;
 use crate::ray::Ray;
@@ -32,10 +32,7 @@ use crate::stats::Counters;
 /// Hard cap on tentative collisions in one tracker call.
 pub const MAX_COLLISIONS: u32 = 1_000_000;
 
-/// pbrt-v4 (`TraceTransmittance`): roulette once the estimate is below this...
-pub const ROULETTE_THRESHOLD: f32 = 0.05;
-/// ...terminating with this probability, else dividing by `1 - q`.
-pub const ROULETTE_Q: f32 = 0.75;
+pub use roulette::{ROULETTE_Q, ROULETTE_THRESHOLD};
 
 settings_enum! {
     /// How shadow rays estimate transmittance.
