@@ -7,7 +7,11 @@
 #
 # Covers every integrator and estimator, chromatic media, phases, the sky
 # map, motion blur, emission, the example scene, AOVs, the global and
-# automatic majorants, .nvdb and .cbrk input, and crops with their merge.
+# automatic majorants, .nvdb and .cbrk input, light groups, deep images, a depth holdout, sunward scattering on and off, one and
+# every light per vertex, a back-lit Mie cloud, and crops with their merge.
+# Not Cryptomatte: the exr crate writes a layer's text attributes (its
+# manifest and names) in hash-map order, so the same pixels come in files
+# whose header bytes differ from run to run.
 # Prints one line per image and exits non-zero if any differ. NEW_FLAGS,
 # if set, is added to every render of the new build (say, to turn off a
 # default the old build did not have: NEW_FLAGS="--sunward off").
@@ -54,6 +58,13 @@ suite=(
   "emission_march|$emission_scene --integrator raymarch"
   "scene|data/scene_example.toml --res 96x54 --spp 2 --aov albedo,depth"
   "scene_march|data/scene_example.toml --res 96x54 --spp 1 --integrator raymarch"
+  "light_groups|data/cloud.vdb --res 64x48 --spp 4 --aov lights"
+  "deep|data/cloud.vdb --res 64x48 --spp 4 --deep @OUT@/deep.deep.exr --deep-samples 4"
+  "holdout|data/cloud.vdb --res 64x48 --spp 4 --holdout-depth @OUT@/aovs.exr:depth.Z"
+  "sunward_on|data/cloud.vdb --res 64x48 --spp 4 --sunward on"
+  "sunward_off|data/cloud.vdb --res 64x48 --spp 4 --sunward off"
+  "every_light|data/cloud.vdb --res 64x48 --spp 4 --light-sampling all"
+  "backlit_mie|data/cloud.vdb --res 64x48 --spp 4 --camera-from 150,83,-250 --camera-to 150,83,100 --sun-dir 0.05,0,-1 --phase mie --env-radiance 0.02,0.02,0.03"
 )
 
 failed=0
@@ -65,6 +76,7 @@ for build in old new; do
   for entry in "${suite[@]}"; do
     name=${entry%%|*}
     args=${entry#*|}
+    args=${args//@OUT@/$d}
     # shellcheck disable=SC2086
     "$bin" render $args $extra -o "$d/$name.exr" >/dev/null 2>"$d/$name.log" ||
       { echo "$build $name: render failed (see $d/$name.log)"; failed=1; }

@@ -62,6 +62,7 @@ pub mod majorant_choice;
 pub mod medium;
 mod path_setup;
 pub mod phase;
+mod pixel_sampler;
 pub mod ray;
 pub mod render;
 pub mod sampling;

@@ -25,7 +25,8 @@ use crate::integrator::CameraSampler;
 use crate::light::Lights;
 use crate::medium::{GlobalMedia, Media};
 use crate::path_setup::{path_tracer, ShadowGrid};
-use crate::sampling::Rng;
+use crate::pixel_sampler::PixelSampler;
+use crate::sampling::{Rng, SampleStream};
 use crate::scene::{MajorantMode, RenderSettings};
 use crate::stats::Counters;
 use rayon::prelude::*;
@@ -128,6 +129,8 @@ fn probe<M: Media>(
     // grid few deep in a thick cloud), which shifts the balance between
     // the structures.
     let tracer = path_tracer(media, lights, settings, shadows);
+    // The render's own camera rays: shutter time and holdout included.
+    let camera_rays = PixelSampler::new(camera, settings);
     let (w, h) = (camera.width().max(1), camera.height().max(1));
     let pixels = u64::from(w) * u64::from(h);
     // Each path has its own numbers and counts add, so the sum is the same
@@ -144,9 +147,9 @@ fn probe<M: Media>(
                 let before = ProbeCost::of(&c).cost();
                 let mut rng = Rng::new(PROBE_SEED, u64::from(i), 0);
                 let pixel = (rng.next_u64() % pixels) as u32;
-                let (x, y) = (pixel % w, pixel / w);
-                let ray = camera.ray(x as f32 + rng.uniform(), y as f32 + rng.uniform());
-                tracer.sample(ray, &mut rng, &mut c);
+                let mut draws = SampleStream::random(rng);
+                let ray = camera_rays.ray(pixel % w, pixel / w, &mut draws);
+                tracer.sample_stream(ray, &mut draws, &mut c);
                 let path = ProbeCost::of(&c).cost() - before;
                 // A float sum in an atomic: only compared with the limit.
                 let _ = spent.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |bits| {

@@ -46,7 +46,7 @@ pub(crate) fn shadow_grid<M: Media>(
 ) -> Option<ShadowGrid> {
     let start = Instant::now();
     let picks = settings.integrator == IntegratorKind::Path
-        && path_tracer(media, lights, settings, None).picks_one_light();
+        && settings.light_sampling.picks_one(&lights.clone().pruned());
     picks.then(|| ShadowGrid {
         grid: LightGrid::for_light_choice(media, lights),
         seconds: start.elapsed().as_secs_f64(),

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use crate::adaptive::{Adaptive, Selection};
 use crate::camera::Camera;
-use crate::compositing::{DepthHoldout, Layers};
+use crate::compositing::Layers;
 use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Image, Tile};
 use crate::integrator::{CameraSampler, IntegratorKind, LightGrid, RayMarcher, TwoPassMarcher};
@@ -17,9 +17,9 @@ use crate::light::Lights;
 use crate::majorant_choice;
 use crate::medium::{GlobalMedia, Media};
 use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGrid};
-use crate::sampling::{Draw, SampleStream, SamplerKind};
+use crate::pixel_sampler::PixelSampler;
+use crate::sampling::{SampleStream, SamplerKind};
 use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
-use crate::shutter::Shutter;
 use crate::stats::{Counters, RenderStats};
 
 /// A finished render.
@@ -245,12 +245,10 @@ fn run<S: CameraSampler>(
     let progress = Progress::new(settings, film.width, film.height);
     let passes = Passes {
         sampler,
-        camera,
-        shutter: settings.shutter,
+        pixels: PixelSampler::new(camera, settings),
         kind: settings.sampler,
         seed: settings.seed,
         progress: &progress,
-        holdout: settings.compositing.holdout_depth.as_deref(),
     };
     let spp = match (settings.budget, settings.adaptive) {
         (Budget::Spp(n), None) => {
@@ -359,12 +357,10 @@ const CANCEL_CHECK: u32 = 64;
 /// What every pass of one render shares.
 struct Passes<'a, S> {
     sampler: &'a S,
-    camera: &'a Camera,
-    shutter: Shutter,
+    pixels: PixelSampler<'a>,
     kind: SamplerKind,
     seed: u64,
     progress: &'a Progress,
-    holdout: Option<&'a DepthHoldout>,
 }
 
 impl<S: CameraSampler> Passes<'_, S> {
@@ -418,18 +414,13 @@ impl<S: CameraSampler> Passes<'_, S> {
         // Numbers are keyed by the pixel's index in the full image, so a
         // crop renders exactly the full render's values for its pixels.
         let (x, y) = (tile.x0 + tx, tile.y0 + ty);
-        let index = u64::from(y) * u64::from(self.camera.width()) + u64::from(x);
+        let camera = self.pixels.camera();
+        let index = u64::from(y) * u64::from(camera.width()) + u64::from(x);
         for s in s0..s1 {
             let mut draws = SampleStream::new(self.kind, self.seed, index, s);
-            let (u, v) = draws.get_2d(Draw::PixelJitter, 0);
-            let time = self.shutter.sample(&draws);
-            let ray = self.camera.ray_at(x as f32 + u, y as f32 + v, time);
-            let ray = match self.holdout {
-                Some(h) => ray.with_t_max(h.t_max(x, y, ray.dir, self.camera.forward())),
-                None => ray,
-            };
+            let ray = self.pixels.ray(x, y, &mut draws);
             let sample = self.sampler.sample_stream(ray, &mut draws, c);
-            tile.add(tx, ty, sample, ray.dir.dot(self.camera.forward()), c);
+            tile.add(tx, ty, sample, ray.dir.dot(camera.forward()), c);
             if rule.is_some_and(|r| r.is_checkpoint(s + 1) && r.converged(&tile.pixels[i])) {
                 tile.stopped[i] = true;
                 return u64::from(s + 1 - s0);

@@ -60,6 +60,12 @@ settings_enum! {
 }
 
 impl LightSampling {
+    /// Whether a vertex picks one light under `lights` (pruned of the dark
+    /// ones): `one`, resolved, with a sun or a sky to pick.
+    pub fn picks_one(self, lights: &Lights) -> bool {
+        self.resolve(lights) == Self::One && (lights.sun.is_some() || lights.environment.is_some())
+    }
+
     /// What `self` comes to under `lights`: `All` or `One`.
     pub fn resolve(self, lights: &Lights) -> LightSampling {
         match self {

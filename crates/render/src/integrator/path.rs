@@ -135,8 +135,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     /// Whether each vertex picks its light (`one`, resolved: a constant
     /// sky, with or without a sun), which a shadow grid would serve.
     pub fn picks_one_light(&self) -> bool {
-        self.light_sampling == LightSampling::One
-            && (self.lights.sun.is_some() || self.lights.environment.is_some())
+        self.light_sampling.picks_one(&self.lights)
     }
 
     /// What the vertex at `p`, reached along `dir_in`, sees of each light
