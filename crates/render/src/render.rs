@@ -267,58 +267,9 @@ fn run<S: CameraSampler>(
             *counters += passes.run(&mut film, plan).0;
             max_count(&film)
         }
-        (Budget::Time(seconds), None) => {
-            let budget = Duration::from_secs_f64(seconds.max(0.0));
-            let loop_start = Instant::now();
-            let mut spp = 0u32;
-            let mut size = 1u32;
-            while size > 0 && !progress.cancelled() {
-                let plan = Plan::Uniform {
-                    s0: spp,
-                    s1: spp + size,
-                };
-                *counters += passes.run(&mut film, plan).0;
-                spp += size;
-                progress.set_spp(spp);
-                // Next pass: as many samples as the measured rate says fit in
-                // the remaining time, at most twice the last pass so one
-                // noisy estimate cannot overshoot the budget badly.
-                let per_spp = loop_start.elapsed().as_secs_f64() / spp as f64;
-                let remaining = budget.saturating_sub(start.elapsed()).as_secs_f64();
-                let fit = (remaining / per_spp.max(1e-9)).floor().min(u32::MAX as f64) as u32;
-                size = fit.min(size.saturating_mul(2));
-            }
-            spp
-        }
+        (Budget::Time(seconds), None) => passes.timed_uniform(&mut film, seconds, start, counters),
         (Budget::Time(seconds), Some(rule)) => {
-            let budget = Duration::from_secs_f64(seconds.max(0.0));
-            let mut size = 1u32;
-            while size > 0 && !progress.cancelled() {
-                let pass_start = Instant::now();
-                let (selection, pixels) = Selection::next(&film, &rule);
-                if pixels == 0 {
-                    break; // every pixel is below the threshold
-                }
-                let plan = Plan::Adaptive {
-                    rule,
-                    selection: Some(selection),
-                    count: size,
-                    max: u32::MAX,
-                };
-                let (c, taken) = passes.run(&mut film, plan);
-                *counters += c;
-                progress.set_spp(max_count(&film));
-                // As the uniform loop, with the cost per sample of the last
-                // pass alone: passes move from cheap sky pixels to costly
-                // cloud pixels, so the running average would overshoot.
-                // The next pass takes `size` samples of about as many
-                // pixels as this one.
-                let per_sample = pass_start.elapsed().as_secs_f64() / taken.max(1) as f64;
-                let remaining = budget.saturating_sub(start.elapsed()).as_secs_f64();
-                let fit = remaining / (per_sample * pixels as f64).max(1e-9);
-                size = (fit.floor().min(u32::MAX as f64) as u32).min(size.saturating_mul(2));
-            }
-            max_count(&film)
+            passes.timed_adaptive(&mut film, rule, seconds, start, counters)
         }
     };
     progress.finish();
@@ -364,6 +315,79 @@ struct Passes<'a, S> {
 }
 
 impl<S: CameraSampler> Passes<'_, S> {
+    /// Progressive uniform passes until `seconds` of wall time since
+    /// `start` are spent; returns the samples per pixel reached.
+    fn timed_uniform(
+        &self,
+        film: &mut Film,
+        seconds: f64,
+        start: Instant,
+        counters: &mut Counters,
+    ) -> u32 {
+        let budget = Duration::from_secs_f64(seconds.max(0.0));
+        let loop_start = Instant::now();
+        let mut spp = 0u32;
+        let mut size = 1u32;
+        while size > 0 && !self.progress.cancelled() {
+            let plan = Plan::Uniform {
+                s0: spp,
+                s1: spp + size,
+            };
+            *counters += self.run(film, plan).0;
+            spp += size;
+            self.progress.set_spp(spp);
+            // Next pass: as many samples as the measured rate says fit in
+            // the remaining time, at most twice the last pass so one
+            // noisy estimate cannot overshoot the budget badly.
+            let per_spp = loop_start.elapsed().as_secs_f64() / spp as f64;
+            let remaining = budget.saturating_sub(start.elapsed()).as_secs_f64();
+            let fit = (remaining / per_spp.max(1e-9)).floor().min(u32::MAX as f64) as u32;
+            size = fit.min(size.saturating_mul(2));
+        }
+        spp
+    }
+
+    /// Adaptive passes, each to the pixels of highest error, until
+    /// `seconds` are spent or every pixel is below the threshold; returns
+    /// the most samples any pixel took.
+    fn timed_adaptive(
+        &self,
+        film: &mut Film,
+        rule: Adaptive,
+        seconds: f64,
+        start: Instant,
+        counters: &mut Counters,
+    ) -> u32 {
+        let budget = Duration::from_secs_f64(seconds.max(0.0));
+        let mut size = 1u32;
+        while size > 0 && !self.progress.cancelled() {
+            let pass_start = Instant::now();
+            let (selection, pixels) = Selection::next(film, &rule);
+            if pixels == 0 {
+                break; // every pixel is below the threshold
+            }
+            let plan = Plan::Adaptive {
+                rule,
+                selection: Some(selection),
+                count: size,
+                max: u32::MAX,
+            };
+            let (c, taken) = self.run(film, plan);
+            *counters += c;
+            self.progress.set_spp(max_count(film));
+            // As the uniform loop, with the cost per sample of the last
+            // pass alone: passes move from cheap sky pixels to costly
+            // cloud pixels, so the running average would overshoot.
+            // The next pass takes `size` samples of about as many
+            // pixels as this one.
+            let per_sample = pass_start.elapsed().as_secs_f64() / taken.max(1) as f64;
+            let remaining = budget.saturating_sub(start.elapsed()).as_secs_f64();
+            let fit = remaining / (per_sample * pixels as f64).max(1e-9);
+            size = (fit.floor().min(u32::MAX as f64) as u32).min(size.saturating_mul(2));
+        }
+        max_count(film)
+    }
+
     /// One pass over the film, tiles in parallel; returns the work
     /// counters and the number of samples taken.
     fn run(&self, film: &mut Film, plan: Plan) -> (Counters, u64) {
