@@ -17,8 +17,7 @@
 
 use glam::Vec3;
 
-use crate::medium::{MajorantSegment, Media};
-use crate::ray::Ray;
+use crate::medium::MajorantSegment;
 use crate::sampling::Rng;
 use crate::stats::Counters;
 use crate::tracking::roulette::{ROULETTE_Q, ROULETTE_THRESHOLD};
@@ -82,14 +81,14 @@ pub trait Spectrum: Copy + Send + Sync + std::fmt::Debug + 'static {
 
     /// Decides a free flight's tentative collision at `t` inside `segment`
     /// and weights `beta` for it (see `tracking::delta`).
-    fn collide<M: Media>(
-        medium: &M,
-        ray: &Ray,
-        t: f32,
+    /// `extinction` looks the medium up there (and counts it), called at
+    /// most once and only where the decision needs it.
+    fn collide(
         segment: &MajorantSegment,
         beta: &mut Vec3,
         rng: &mut Rng,
         c: &mut Counters,
+        extinction: impl FnOnce(&mut Counters) -> Self,
     ) -> Collision;
     /// Alpha (`1 - T`) of a camera ray whose first free flight escaped
     /// with throughput `beta`: 0 for a scalar flight (its escape indicator
@@ -103,25 +102,6 @@ pub trait Spectrum: Copy + Send + Sync + std::fmt::Debug + 'static {
 #[inline]
 pub fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
-
-/// Extinction at a tentative collision, at the ray's time, counted, with
-/// majorant violations (density above the segment's bound) counted too.
-#[inline]
-pub(crate) fn lookup<S: Spectrum, M: Media>(
-    medium: &M,
-    ray: &Ray,
-    t: f32,
-    majorant: f32,
-    c: &mut Counters,
-) -> S {
-    c.density_lookups += 1;
-    let sigma: S = medium.extinction(ray.at(t), ray.time);
-    // A relative slack of 1e-5 forgives the f32 rounding of interpolation.
-    if sigma.max_channel() > majorant * (1.0 + 1e-5) {
-        c.majorant_violations += 1;
-    }
-    sigma.clamp_to_majorant(majorant)
 }
 
 impl Spectrum for f32 {
@@ -214,17 +194,15 @@ impl Spectrum for f32 {
     /// only cheaper (the control part of decomposition tracking, Kutz et
     /// al. 2017).
     #[inline]
-    fn collide<M: Media>(
-        medium: &M,
-        ray: &Ray,
-        t: f32,
+    fn collide(
         segment: &MajorantSegment,
         _beta: &mut Vec3,
         rng: &mut Rng,
         c: &mut Counters,
+        extinction: impl FnOnce(&mut Counters) -> Self,
     ) -> Collision {
         let xi = rng.uniform() * segment.majorant;
-        if xi < segment.minorant || xi < lookup::<f32, M>(medium, ray, t, segment.majorant, c) {
+        if xi < segment.minorant || xi < extinction(c) {
             Collision::Real
         } else {
             Collision::Null
@@ -337,17 +315,15 @@ impl Spectrum for Vec3 {
     /// With equal channels it is delta tracking: `P_r = sigma_t /
     /// sigma_maj` and the weights are 1.
     #[inline]
-    fn collide<M: Media>(
-        medium: &M,
-        ray: &Ray,
-        t: f32,
+    fn collide(
         segment: &MajorantSegment,
         beta: &mut Vec3,
         rng: &mut Rng,
         c: &mut Counters,
+        extinction: impl FnOnce(&mut Counters) -> Self,
     ) -> Collision {
         let maj = segment.majorant;
-        let sigma = lookup::<Vec3, M>(medium, ray, t, maj, c);
+        let sigma = extinction(c);
         let mean_beta = beta.element_sum();
         if mean_beta.is_nan() || mean_beta <= 0.0 {
             *beta = Vec3::ZERO;

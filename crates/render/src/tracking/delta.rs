@@ -9,6 +9,7 @@ use crate::sampling::Rng;
 use crate::spectrum::{Collision, Spectrum};
 use crate::stats::Counters;
 
+use super::lookup::lookup;
 use super::walk::{Event, Walk};
 
 /// Where a free flight ended.
@@ -51,7 +52,9 @@ pub fn sample_free_flight<S: Spectrum, M: Media>(
             Event::End => return FreeFlight::Escaped,
             Event::Capped => return FreeFlight::Capped,
             Event::Collision { t, segment, .. } => {
-                match S::collide(medium, ray, t, &segment, beta, rng, c) {
+                let extinction =
+                    |c: &mut Counters| lookup::<S, M>(medium, ray, t, segment.majorant, c);
+                match S::collide(&segment, beta, rng, c, extinction) {
                     Collision::Real => {
                         c.real_collisions += 1;
                         return FreeFlight::Collision { t };

@@ -12,6 +12,7 @@
 //! ([`Spectrum::roulette`]).
 
 mod delta;
+mod lookup;
 mod ratio;
 mod residual;
 pub(crate) mod roulette;

@@ -3,7 +3,9 @@
 use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::Rng;
-use crate::spectrum::{lookup, Spectrum};
+use crate::spectrum::Spectrum;
+
+use super::lookup::lookup;
 use crate::stats::Counters;
 
 use super::walk::{Event, Walk};
