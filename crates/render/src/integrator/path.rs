@@ -132,12 +132,6 @@ impl<'a, M: Media> PathTracer<'a, M> {
         self.light_sampling
     }
 
-    /// Whether each vertex picks its light (`one`, resolved: a constant
-    /// sky, with or without a sun), which a shadow grid would serve.
-    pub fn picks_one_light(&self) -> bool {
-        self.light_sampling.picks_one(&self.lights)
-    }
-
     /// What the vertex at `p`, reached along `dir_in`, sees of each light
     /// through the media, where a shadow grid is given.
     #[inline]
