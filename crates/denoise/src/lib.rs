@@ -19,6 +19,10 @@
 //!   image) and a cached "RT" filter; [`Denoiser::denoise`] checks the sizes,
 //!   replaces non-finite inputs by 0, runs the filter on RGB `f32` images and
 //!   guarantees a finite output.
+//! - [`blend`] weighs the noisy image against the denoised one per pixel by
+//!   each one's estimated error (the denoiser's measured on the two
+//!   independent halves of the samples), so raising the sample count never
+//!   makes the final image worse.
 //!
 //! ```no_run
 //! # fn main() -> Result<(), cirrus_denoise::DenoiseError> {
@@ -30,6 +34,7 @@
 //! # Ok(()) }
 //! ```
 
+pub mod blend;
 mod ffi;
 mod search;
 

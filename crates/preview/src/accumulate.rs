@@ -124,7 +124,8 @@ mod tests {
                 full_height: 1,
             },
             aovs: None,
-            noisy: None,
+            halves: None,
+            denoised: None,
             layers: None,
         }
     }

@@ -123,10 +123,13 @@ pub fn write_exr_with(
             "AOVs were asked for but the render did not keep them",
         ));
     }
-    if let Some(noisy) = &r.noisy {
-        for (c, n) in ["noisy.R", "noisy.G", "noisy.B"].iter().enumerate() {
-            channels.push((n.to_string(), noisy.iter().map(|p| p[c]).collect()));
+    if let Some(d) = &r.denoised {
+        for (layer, rgb) in [("noisy", &d.noisy), ("denoised", &d.plain)] {
+            for (c, n) in ["R", "G", "B"].iter().enumerate() {
+                channels.push((format!("{layer}.{n}"), rgb.iter().map(|p| p[c]).collect()));
+            }
         }
+        channels.push(("blend.weight".into(), d.noisy_weight.clone()));
     }
     channels.extend(extra);
     let w = &r.window;

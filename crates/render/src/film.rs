@@ -78,6 +78,37 @@ impl PixelAccumulator {
     }
 }
 
+/// The image's samples split into two independent halves: each pixel's
+/// even-numbered samples (`a`) and its odd-numbered ones (`b`), as running
+/// means of RGB. Two images of the same pixels with independent noise let
+/// a denoiser's error be measured against data it never saw (one half is
+/// filtered, the other is the reference); the two together are exactly the
+/// image's samples, so keeping them changes no pixel of the image.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Halves {
+    pub a: Vec<[f32; 3]>,
+    pub b: Vec<[f32; 3]>,
+    /// Samples in `a` and in `b` per pixel, row-major like `a`.
+    pub samples: Vec<[u32; 2]>,
+}
+
+/// Running means of one pixel's even and odd samples (see [`Halves`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HalfAccumulator {
+    n: [u32; 2],
+    mean: [Vec3; 2],
+}
+
+impl HalfAccumulator {
+    /// Adds sample number `index` of the pixel (counted from 0).
+    #[inline]
+    fn add(&mut self, index: u32, rgb: Vec3) {
+        let h = (index & 1) as usize;
+        self.n[h] += 1;
+        self.mean[h] += (rgb - self.mean[h]) / self.n[h] as f32;
+    }
+}
+
 /// The compositing passes of an image (or of its crop window), row-major
 /// like [`Image::rgba`]. Each is the per-pixel mean of its
 /// [`AovSample`] part over all samples, except `depth`: the mean over the
@@ -132,6 +163,8 @@ pub(crate) struct Tile {
     pub stopped: Vec<bool>,
     /// Empty unless the render keeps AOVs.
     pub aovs: Vec<AovAccumulator>,
+    /// Empty unless the render keeps the two halves of its samples.
+    pub halves: Vec<HalfAccumulator>,
     /// Light groups, coverage and deep bins, when kept.
     pub layers: TileLayers,
 }
@@ -153,6 +186,11 @@ impl Tile {
             [0.0; 4]
         };
         let i = (y * self.w + x) as usize;
+        if let Some(h) = self.halves.get_mut(i) {
+            // The pixel's count before this sample is the sample's number:
+            // samples are added in order.
+            h.add(self.pixels[i].count(), Vec3::new(v[0], v[1], v[2]));
+        }
         self.pixels[i].add(v);
         self.layers.add(i, &s, finite, view_cos);
         if let Some(a) = self.aovs.get_mut(i) {
@@ -172,16 +210,18 @@ pub(crate) struct Film {
     pub height: u32,
     pub tiles: Vec<Tile>,
     pub aovs: bool,
+    pub halves: bool,
     pub compositing: Compositing,
 }
 
 impl Film {
     /// Tiles of edge `tile` over the window; AOV accumulators if `aovs`,
-    /// and the layers `compositing` asks for.
+    /// half-image accumulators if `halves`, and the layers `compositing`
+    /// asks for.
     pub fn new(
         (x0, y0, width, height): (u32, u32, u32, u32),
         tile: u32,
-        aovs: bool,
+        (aovs, halves): (bool, bool),
         compositing: &Compositing,
     ) -> Self {
         let tile = tile.max(1);
@@ -202,6 +242,11 @@ impl Film {
                     } else {
                         Vec::new()
                     },
+                    halves: if halves {
+                        vec![HalfAccumulator::default(); n]
+                    } else {
+                        Vec::new()
+                    },
                     layers: TileLayers::new(compositing, n),
                 });
             }
@@ -213,6 +258,7 @@ impl Film {
             height,
             tiles,
             aovs,
+            halves,
             compositing: compositing.clone(),
         }
     }
@@ -261,6 +307,40 @@ impl Film {
                     if a.hits > 0 {
                         out.depth[i] = a.depth;
                     }
+                }
+            }
+        }
+        Some(out)
+    }
+
+    /// The two halves of the samples so far (`None` unless the film keeps
+    /// them). A non-finite mean (overflow) is zeroed, as in [`Film::resolve`].
+    pub fn resolve_halves(&self) -> Option<Halves> {
+        if !self.halves {
+            return None;
+        }
+        let n = (self.width * self.height) as usize;
+        let mut out = Halves {
+            a: vec![[0.0; 3]; n],
+            b: vec![[0.0; 3]; n],
+            samples: vec![[0; 2]; n],
+        };
+        let finite = |v: Vec3| {
+            if v.is_finite() {
+                v.to_array()
+            } else {
+                [0.0; 3]
+            }
+        };
+        for tile in &self.tiles {
+            for ty in 0..tile.h {
+                for tx in 0..tile.w {
+                    let h = &tile.halves[(ty * tile.w + tx) as usize];
+                    let i =
+                        ((tile.y0 - self.y0 + ty) * self.width + tile.x0 - self.x0 + tx) as usize;
+                    out.a[i] = finite(h.mean[0]);
+                    out.b[i] = finite(h.mean[1]);
+                    out.samples[i] = h.n;
                 }
             }
         }

@@ -83,7 +83,7 @@ pub use compositing::{Compositing, DepthHoldout, Layers, LightGroup};
 pub use control::RenderControl;
 pub use env_map::EnvMap;
 pub use error::{Error, Result};
-pub use film::{AovImage, Image};
+pub use film::{AovImage, Halves, Image};
 pub use integrator::{
     AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, LightSampling,
     PathTracer, RayMarcher, Sample, Sunward, TwoPassMarcher,
@@ -97,7 +97,7 @@ pub use medium::{
 pub use medium::{ConstantBox, GridField, MajorantGrid};
 pub use phase::{HenyeyGreenstein, Phase};
 pub use ray::Ray;
-pub use render::{render, Rendered, Window};
+pub use render::{render, Denoised, Rendered, Window};
 pub use sampling::{Rng, SampleStream, SamplerKind};
 pub use scene::{
     Budget, Crop, MajorantMode, RenderSettings, Scene, DEFAULT_SPP, DEFAULT_STEP_VOXELS,

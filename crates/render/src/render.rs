@@ -11,7 +11,7 @@ use crate::adaptive::{Adaptive, Selection};
 use crate::camera::Camera;
 use crate::compositing::Layers;
 use crate::control::RenderControl;
-use crate::film::{AovImage, Film, Image, Tile};
+use crate::film::{AovImage, Film, Halves, Image, Tile};
 use crate::integrator::{CameraSampler, IntegratorKind, LightGrid, RayMarcher, TwoPassMarcher};
 use crate::light::Lights;
 use crate::majorant_choice;
@@ -31,11 +31,23 @@ pub struct Rendered {
     pub window: Window,
     /// The AOV passes over the same pixels, if the settings asked for them.
     pub aovs: Option<AovImage>,
-    /// The image's RGB before a denoiser replaced it (written as the
-    /// `noisy.R/G/B` layer).
-    pub noisy: Option<Vec<[f32; 3]>>,
+    /// The two halves of the image's samples, if the settings asked for
+    /// them (a denoiser's error is measured with them).
+    pub halves: Option<Halves>,
+    /// What a denoiser made of the image, once one has replaced its RGB.
+    pub denoised: Option<Denoised>,
     /// Light groups, Cryptomatte coverage and deep samples, if kept.
     pub layers: Option<Layers>,
+}
+
+/// The layers a denoiser leaves beside the image it replaced: the noisy
+/// RGB, the plain denoised RGB, and per pixel the weight the final image
+/// gives the noisy one (`final = w * noisy + (1 - w) * denoised`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Denoised {
+    pub noisy: Vec<[f32; 3]>,
+    pub plain: Vec<[f32; 3]>,
+    pub noisy_weight: Vec<f32>,
 }
 
 /// Placement of a rendered window in the full image (an EXR data window
@@ -136,19 +148,26 @@ fn render_with<M: Media>(
             full_height: camera.height(),
         },
         aovs: out.aovs,
-        noisy: None,
+        halves: out.halves,
+        denoised: None,
         layers: out.layers,
     }
 }
 
-/// The image, AOVs and layers the sample passes resolve to.
-type Resolved = (Image, Option<AovImage>, Option<Layers>);
+/// What the sample passes resolve to.
+struct Resolved {
+    image: Image,
+    aovs: Option<AovImage>,
+    layers: Option<Layers>,
+    halves: Option<Halves>,
+}
 
 /// What the integrator's passes made, with what its setup reports.
 struct Integrated {
     image: Image,
     aovs: Option<AovImage>,
     layers: Option<Layers>,
+    halves: Option<Halves>,
     /// Seconds from the render's start to its first sample pass (shadow
     /// grids).
     setup_seconds: f64,
@@ -166,10 +185,11 @@ fn integrate<M: Media>(
     counters: &mut Counters,
 ) -> Integrated {
     let lights = lights.clone();
-    let done = |(image, aovs, layers): Resolved, setup_seconds: f64| Integrated {
-        image,
-        aovs,
-        layers,
+    let done = |r: Resolved, setup_seconds: f64| Integrated {
+        image: r.image,
+        aovs: r.aovs,
+        layers: r.layers,
+        halves: r.halves,
         setup_seconds,
         light_sampling: String::new(),
     };
@@ -239,7 +259,7 @@ fn run<S: CameraSampler>(
     let mut film = Film::new(
         (crop.x0, crop.y0, crop.x1 - crop.x0, crop.y1 - crop.y0),
         settings.tile_size,
-        settings.aovs,
+        (settings.aovs, settings.halves),
         &settings.compositing,
     );
     let progress = Progress::new(settings, film.width, film.height);
@@ -273,9 +293,12 @@ fn run<S: CameraSampler>(
         }
     };
     progress.finish();
-    let image = film.resolve(spp, counters);
-    let layers = film.resolve_layers();
-    (image, film.resolve_aovs(), layers)
+    Resolved {
+        image: film.resolve(spp, counters),
+        aovs: film.resolve_aovs(),
+        layers: film.resolve_layers(),
+        halves: film.resolve_halves(),
+    }
 }
 
 /// The most samples any pixel of `film` has.

@@ -98,6 +98,9 @@ pub struct RenderSettings {
     pub crop: Option<Crop>,
     /// Keep the AOV passes (albedo, depth, emission, direct, samples).
     pub aovs: bool,
+    /// Keep the two halves of each pixel's samples beside the image
+    /// ([`Halves`](crate::film::Halves)), for a denoiser's error estimate.
+    pub halves: bool,
     /// Progress and cancellation from another thread (bindings, servers).
     pub control: Option<Arc<RenderControl>>,
     /// Each camera sample's time is drawn over this interval (frames);
@@ -154,6 +157,7 @@ impl Default for RenderSettings {
             progress: true,
             crop: None,
             aovs: false,
+            halves: false,
             control: None,
             shutter: Shutter::INSTANT,
             compositing: Compositing::default(),

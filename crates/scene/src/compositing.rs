@@ -20,12 +20,14 @@ pub const OBJECT_LAYER: &str = "CryptoObject";
 pub const ASSET_LAYER: &str = "CryptoAsset";
 
 /// Layer names the EXR already uses: a light group may not take one.
-const RESERVED: [&str; 7] = [
+const RESERVED: [&str; 9] = [
     "albedo",
     "depth",
     "direct",
     "samples",
     "noisy",
+    "denoised",
+    "blend",
     OBJECT_LAYER,
     ASSET_LAYER,
 ];
@@ -271,11 +273,16 @@ pub(crate) fn renumber_instances(r: &mut Rendered, kept: &[usize]) {
 
 /// After denoising the beauty: each light group is denoised with the same
 /// albedo guide by `denoise`, then scaled per pixel and channel so the
-/// groups sum to the denoised beauty (the denoiser is not linear, so the
-/// groups denoised alone would not). A pixel whose denoised groups are
-/// all zero keeps the noisy groups' proportions.
+/// groups sum to the plain denoised beauty `plain` (the denoiser is not
+/// linear, so the groups denoised alone would not), then blended with its
+/// noisy self by the beauty's weights, so the groups sum to the blended
+/// beauty `w * noisy + (1 - w) * plain` as the noisy groups summed to the
+/// noisy beauty. A pixel whose denoised groups are all zero keeps the
+/// noisy groups' proportions.
 pub(crate) fn denoise_groups(
     r: &mut Rendered,
+    plain: &[[f32; 3]],
+    noisy_weight: &[f32],
     mut denoise: impl FnMut(&[[f32; 3]]) -> Result<Vec<[f32; 3]>>,
 ) -> Result<()> {
     let Some(layers) = r.layers.as_mut() else {
@@ -286,24 +293,26 @@ pub(crate) fn denoise_groups(
         .iter()
         .map(|g| denoise(g))
         .collect::<Result<_>>()?;
-    for (i, beauty) in r.image.rgba.iter().enumerate() {
+    let n = layers.groups.len().max(1) as f32;
+    for (i, (beauty, &w)) in plain.iter().zip(noisy_weight).enumerate() {
         for c in 0..3 {
             let weights: Vec<f32> = clean.iter().map(|g| g[i][c].max(0.0)).collect();
-            let noisy: Vec<f32> = layers.groups.iter().map(|g| g[i][c].max(0.0)).collect();
-            let (w, total) = match weights.iter().sum::<f32>() {
+            let noisy: Vec<f32> = layers.groups.iter().map(|g| g[i][c]).collect();
+            let (shares, total) = match weights.iter().sum::<f32>() {
                 s if s > 0.0 => (weights, s),
                 _ => {
-                    let s = noisy.iter().sum::<f32>();
-                    (noisy, s)
+                    let kept: Vec<f32> = noisy.iter().map(|v| v.max(0.0)).collect();
+                    let s = kept.iter().sum::<f32>();
+                    (kept, s)
                 }
             };
-            let n = layers.groups.len().max(1) as f32;
-            for (g, weight) in layers.groups.iter_mut().zip(&w) {
-                g[i][c] = if total > 0.0 {
-                    beauty[c] * (weight / total)
+            for ((g, share), noisy) in layers.groups.iter_mut().zip(&shares).zip(&noisy) {
+                let denoised = if total > 0.0 {
+                    beauty[c] * (share / total)
                 } else {
                     beauty[c] / n
                 };
+                g[i][c] = w * noisy + (1.0 - w) * denoised;
             }
         }
     }

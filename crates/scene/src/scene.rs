@@ -149,8 +149,10 @@ impl Scene {
         let denoise = self.description.render.denoise.unwrap_or(false);
         let r = &mut settings.render;
         r.crop = outputs.crop;
-        // The denoiser is guided by the albedo AOV.
+        // The denoiser is guided by the albedo AOV, and its error is
+        // measured on the two halves of the samples.
         r.aovs = !outputs.aovs.is_empty() || denoise;
+        r.halves = denoise;
         r.control = control;
         r.progress = self.progress_bar;
         if let Some(c) = &outputs.crop {
