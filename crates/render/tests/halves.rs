@@ -37,9 +37,9 @@ fn keeping_the_halves_changes_no_pixel_and_they_make_up_the_image() {
     for (i, p) in kept.image.rgba.iter().enumerate() {
         // 9 samples: 5 even-numbered (0, 2, ..., 8) and 4 odd.
         assert_eq!(h.samples[i], [5, 4], "pixel {i}");
-        for c in 0..3 {
-            let joined = (5.0 * h.a[i][c] + 4.0 * h.b[i][c]) / 9.0;
-            worst = worst.max((joined - p[c]).abs() / p[c].abs().max(1e-3));
+        for ((a, b), p) in h.a[i].iter().zip(&h.b[i]).zip(p) {
+            let joined = (5.0 * a + 4.0 * b) / 9.0;
+            worst = worst.max((joined - p).abs() / p.abs().max(1e-3));
         }
     }
     // Two running means against one: equal to float rounding.

@@ -120,7 +120,9 @@ declare_settings! {
     /// 1.442; 0 refines to the finest 4^3 cells).
     refine_optical_depth: f32, flag(long), default(1.0), example(0.0);
     /// Denoise with Intel Open Image Denoise 2.x (guided by the albedo
-    /// AOV); the EXR keeps the noisy image as `noisy.R/G/B`.
+    /// AOV), blended with the noisy image by their estimated errors; the
+    /// EXR keeps the noisy image as `noisy.R/G/B`, the plain denoised one
+    /// as `denoised.R/G/B` and the blend's weights as `blend.weight`.
     denoise: bool, flag(long, num_args = 0, default_missing_value = "true"),
         default(false), example(true);
     /// Motion blur: the shutter's open and close times in frames around
