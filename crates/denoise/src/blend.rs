@@ -33,11 +33,10 @@
 //! `w N + (1 - w) D` has the error
 //! `w^2 v + (1 - w)^2 MSE(D) + 2 w (1 - w) C`, least at
 //! `w = (MSE(D) - C) / (v + MSE(D) - 2 C)`, clamped to `[0, 1]`. The
-//! squared bias is counted only beyond one standard error of its
-//! cross-validated estimate: a noisy estimate would otherwise move weight
-//! to the noisy image where the denoised one is better (measured: up to 7%
-//! above the plain denoised image at 16-256 spp on the thick cloud
-//! without it, at or below it with it).
+//! squared bias is counted only beyond [`BIAS_EVIDENCE`] standard errors
+//! of its cross-validated estimate: clamped at 0, a noisy estimate is
+//! biased upward and would move weight to the noisy image where the
+//! denoised one is better.
 //!
 //! Each term is summed over a square window around the pixel and over the
 //! three channels before the weight is formed: one pixel's terms are too
@@ -75,6 +74,16 @@ pub const DEFAULT_RADIUS: usize = 8;
 /// the plain denoised image at low sample counts; 1/2 was within 2% of
 /// this at every point.
 pub const BIAS_SCALE: f64 = 0.629_960_524_947_436_6;
+
+/// Standard errors of the cross-validated bias estimate discounted from it.
+/// A trade measured on the sweeps of BENCHMARKS.md (thick, default and
+/// sky-lit clouds at 128x128, 16-2048 spp; the default cloud at 64x64):
+/// 0 left the blend 1-2% above the plain denoised image at 16-256 spp on
+/// the thick cloud; 1 brought that to 0.97-1.00 but left the blend 9-31%
+/// above the noisy image at 512-2048 spp on the 64x64 cloud, where the
+/// denoiser's bias sits in few pixels of a window; 1/2 gave 0.99-1.00
+/// and 1.00-1.16 there.
+pub const BIAS_EVIDENCE: f64 = 0.5;
 
 /// The error terms of one pixel, summed over its channels.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -155,12 +164,13 @@ impl Terms {
         }
         // The cross-validated error's standard error over the window (its
         // terms' spread, the pixels taken as independent): only the bias
-        // the data shows beyond it is counted, so where the estimate is
-        // noisy (few samples, heavy tails) the denoised image keeps its
-        // weight.
+        // the data shows beyond BIAS_EVIDENCE of it is counted, so where
+        // the estimate is noisy (few samples, heavy tails) the denoised
+        // image keeps its weight.
         let spread = self.denoised_sq - self.denoised * self.denoised / self.valid;
         let standard_error = spread.max(0.0).sqrt();
-        let bias2 = BIAS_SCALE * (self.denoised - self.residual - standard_error).max(0.0);
+        let evidence = self.denoised - self.residual - BIAS_EVIDENCE * standard_error;
+        let bias2 = BIAS_SCALE * evidence.max(0.0);
         let mse_denoised = bias2 + 0.5 * self.residual.max(0.0);
         let covariance = 0.5 * self.covariance;
         let v = self.noisy.max(0.0);

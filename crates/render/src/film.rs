@@ -263,6 +263,21 @@ impl Film {
         }
     }
 
+    /// Calls `visit(tile, local, image)` for every pixel: its tile, its
+    /// index in the tile and its index in the window's row-major image.
+    fn for_each_pixel(&self, mut visit: impl FnMut(&Tile, usize, usize)) {
+        for tile in &self.tiles {
+            for ty in 0..tile.h {
+                for tx in 0..tile.w {
+                    let local = (ty * tile.w + tx) as usize;
+                    let i =
+                        ((tile.y0 - self.y0 + ty) * self.width + tile.x0 - self.x0 + tx) as usize;
+                    visit(tile, local, i);
+                }
+            }
+        }
+    }
+
     /// The compositing layers so far (`None` unless the film keeps any).
     pub fn resolve_layers(&self) -> Option<Layers> {
         if !self.compositing.keeps_layers() {
@@ -294,22 +309,16 @@ impl Film {
             direct: vec![[0.0; 3]; n],
             samples: vec![0.0; n],
         };
-        for tile in &self.tiles {
-            for ty in 0..tile.h {
-                for tx in 0..tile.w {
-                    let a = &tile.aovs[(ty * tile.w + tx) as usize];
-                    let i =
-                        ((tile.y0 - self.y0 + ty) * self.width + tile.x0 - self.x0 + tx) as usize;
-                    out.albedo[i] = a.albedo.to_array();
-                    out.emission[i] = a.emission.to_array();
-                    out.direct[i] = a.direct.to_array();
-                    out.samples[i] = a.n as f32;
-                    if a.hits > 0 {
-                        out.depth[i] = a.depth;
-                    }
-                }
+        self.for_each_pixel(|tile, local, i| {
+            let a = &tile.aovs[local];
+            out.albedo[i] = a.albedo.to_array();
+            out.emission[i] = a.emission.to_array();
+            out.direct[i] = a.direct.to_array();
+            out.samples[i] = a.n as f32;
+            if a.hits > 0 {
+                out.depth[i] = a.depth;
             }
-        }
+        });
         Some(out)
     }
 
@@ -332,18 +341,12 @@ impl Film {
                 [0.0; 3]
             }
         };
-        for tile in &self.tiles {
-            for ty in 0..tile.h {
-                for tx in 0..tile.w {
-                    let h = &tile.halves[(ty * tile.w + tx) as usize];
-                    let i =
-                        ((tile.y0 - self.y0 + ty) * self.width + tile.x0 - self.x0 + tx) as usize;
-                    out.a[i] = finite(h.mean[0]);
-                    out.b[i] = finite(h.mean[1]);
-                    out.samples[i] = h.n;
-                }
-            }
-        }
+        self.for_each_pixel(|tile, local, i| {
+            let h = &tile.halves[local];
+            out.a[i] = finite(h.mean[0]);
+            out.b[i] = finite(h.mean[1]);
+            out.samples[i] = h.n;
+        });
         Some(out)
     }
 
@@ -355,23 +358,17 @@ impl Film {
         let mut rgba = vec![[0.0; 4]; n];
         let mut variance = vec![[0.0; 4]; n];
         let mut samples = vec![0; n];
-        for tile in &self.tiles {
-            for ty in 0..tile.h {
-                for tx in 0..tile.w {
-                    let acc = &tile.pixels[(ty * tile.w + tx) as usize];
-                    let i =
-                        ((tile.y0 - self.y0 + ty) * self.width + tile.x0 - self.x0 + tx) as usize;
-                    let mut m = acc.mean;
-                    if !m.iter().all(|x| x.is_finite()) {
-                        c.nonfinite_samples += 1;
-                        m = [0.0; 4];
-                    }
-                    rgba[i] = m;
-                    variance[i] = acc.variance();
-                    samples[i] = acc.n;
-                }
+        self.for_each_pixel(|tile, local, i| {
+            let acc = &tile.pixels[local];
+            let mut m = acc.mean;
+            if !m.iter().all(|x| x.is_finite()) {
+                c.nonfinite_samples += 1;
+                m = [0.0; 4];
             }
-        }
+            rgba[i] = m;
+            variance[i] = acc.variance();
+            samples[i] = acc.n;
+        });
         Image {
             width: self.width,
             height: self.height,

@@ -3,18 +3,9 @@
 mod common;
 
 use cirrus_render::{render, Budget, IntegratorKind, Lights, MajorantMode, Rendered};
-use glam::Vec3;
 
 fn render_with_threads(threads: usize, kind: IntegratorKind, seed: u64) -> Rendered {
-    let lights = Lights {
-        sun: common::sun(2.0),
-        environment: common::env(Vec3::new(0.2, 0.3, 0.45)),
-    };
-    let scene = common::scene(
-        common::medium(common::cloud_field(4), 8.0, 0.9, 0.5),
-        20,
-        lights,
-    );
+    let scene = common::sunlit_cloud();
     let mut settings = common::settings(kind, 8, seed);
     // Tiles smaller than the image so two workers really share it.
     settings.tile_size = 8;

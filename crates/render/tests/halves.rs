@@ -4,19 +4,10 @@
 
 mod common;
 
-use cirrus_render::{render, IntegratorKind, Lights, Rendered};
-use glam::Vec3;
+use cirrus_render::{render, IntegratorKind, Rendered};
 
 fn render_halves(halves: bool, threads: usize, crop: bool) -> Rendered {
-    let lights = Lights {
-        sun: common::sun(2.0),
-        environment: common::env(Vec3::new(0.2, 0.3, 0.45)),
-    };
-    let scene = common::scene(
-        common::medium(common::cloud_field(4), 8.0, 0.9, 0.5),
-        20,
-        lights,
-    );
+    let scene = common::sunlit_cloud();
     let mut s = common::settings(IntegratorKind::Path, 9, 5);
     s.tile_size = 8;
     s.halves = halves;
