@@ -31,7 +31,7 @@ the sun), cirrus in one or more labelled
 configurations (`--cirrus-config`), Cycles unguided and, with `--cycles-guiding`, guided; a
 converged reference from two long cirrus renders with other seeds (its own noise, estimated
 from their difference, is subtracted from every MSE); each renderer at several spp, unbiased
-and with OIDN (cirrus --denoise, Cycles' OIDN with the albedo pass); MSE, wall and CPU
+and with OIDN (cirrus --denoise, Cycles' OIDN with the albedo and normal passes); MSE, wall and CPU
 seconds (user + sys of the renderer process: the machine is shared, CPU time is the steadier
 measure), efficiency 1 / (MSE x time), and Cycles' fixed cost (a 1-spp render).
 Everything lands in OUT/ as EXRs, `results.json` and `summary.md`; finished renders are
@@ -496,7 +496,7 @@ def efficiency(args) -> int:
                 if (label, spp, denoise) in done:
                     continue
                 pattern = out / f"{label}_{spp}{'_dn' if denoise else ''}_{{seed}}.exr"
-                extra = extra_flags + (["--denoise"] if denoise else [])
+                extra = extra_flags + (["--denoise", "--denoise-passes", args.cycles_denoise_passes] if denoise else [])
                 t = R.cycles_runs(flags, pattern, spp, [7], extra=extra)
                 record(label, spp, denoise, Path(str(pattern).replace("{seed}", "7")), t,
                        cycles_render=t["cycles"]["renders"][0])
@@ -563,6 +563,8 @@ def main(argv=None) -> int:
     e.add_argument("--cirrus-spp", type=int, nargs="+", default=[64, 256, 1024])
     e.add_argument("--cycles-spp", type=int, nargs="+", default=[16, 64, 256])
     e.add_argument("--no-denoise", action="store_true")
+    e.add_argument("--cycles-denoise-passes", default="RGB_ALBEDO_NORMAL",
+                   help="Cycles' denoising_input_passes (RGB_ALBEDO_NORMAL: albedo and normal, as a user sets it)")
     e.add_argument("--scene", choices=list(SCENES), default="sunsky",
                    help="sunsky: HG g 0.5, albedo 0.9, sun 0.53 deg + sky; thick: albedo 0.999, HG g 0.8, delta sun + sky")
     e.add_argument("--cirrus-config", action="append", default=[], metavar="LABEL=FLAGS",

@@ -70,8 +70,9 @@ pub const DEFAULT_RADIUS: usize = 8;
 /// The full image's squared bias over a half's: the rate `n^(-2/3)` of a
 /// noise-tuned smoother in two dimensions, at twice the samples. Measured
 /// on three scenes at four sample counts (BENCHMARKS.md), 1 (the half's
-/// own bias, an upper bound) gave blends 1-5% worse than this and above
-/// the plain denoised image at low sample counts; 1/2 was within 2% of
+/// own bias, an upper bound) left the blend up to 7% above the plain
+/// denoised image at low sample counts on the thick and default clouds
+/// (better only on a 64x64 image at 512-2048 spp); 1/2 was within 2% of
 /// this at every point.
 pub const BIAS_SCALE: f64 = 0.629_960_524_947_436_6;
 
