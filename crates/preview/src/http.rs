@@ -16,13 +16,14 @@
 //! No request names a path: Save writes only `Info::save_exr` and
 //! `Info::save_png`.
 
-use std::io::{Cursor, Read};
+use std::io::Read;
 use std::sync::Arc;
 
 use serde_json::json;
-use tiny_http::{Header, Method, Request, Response};
+use tiny_http::{Method, Request, Response};
 
 use crate::command::render_command;
+use crate::reply::{error, header, json_reply, with_headers, Reply};
 use crate::shared::Shared;
 use crate::view::ViewPatch;
 
@@ -30,8 +31,6 @@ use crate::view::ViewPatch;
 pub const MAX_BODY: usize = 64 * 1024;
 
 const PAGE: &str = include_str!("../page/index.html");
-
-type Reply = Response<Cursor<Vec<u8>>>;
 
 /// Serves requests until the server is unblocked.
 pub fn serve(server: Arc<tiny_http::Server>, shared: Arc<Shared>, hosts: Option<Vec<String>>) {
@@ -205,37 +204,4 @@ fn too_large() -> Reply {
         error(413, "request body over 64 KiB"),
         &[("Connection", "close")],
     )
-}
-
-pub fn header(req: &Request, name: &str) -> Option<String> {
-    req.headers()
-        .iter()
-        .find(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
-        .map(|h| h.value.as_str().to_string())
-}
-
-/// `reply` with the given headers; one that does not parse (never, for
-/// the constants used here) is left out rather than panicking.
-pub fn with_headers<R: Read>(mut reply: Response<R>, headers: &[(&str, &str)]) -> Response<R> {
-    for (name, value) in headers {
-        if let Ok(h) = Header::from_bytes(name.as_bytes(), value.as_bytes()) {
-            reply.add_header(h);
-        }
-    }
-    reply
-}
-
-fn json_reply(code: u16, value: serde_json::Value) -> Reply {
-    with_headers(
-        Response::from_data(value.to_string().into_bytes()).with_status_code(code),
-        &[
-            ("Content-Type", "application/json"),
-            ("Cache-Control", "no-store"),
-            ("X-Content-Type-Options", "nosniff"),
-        ],
-    )
-}
-
-pub fn error(code: u16, message: &str) -> Reply {
-    json_reply(code, json!({"error": message}))
 }

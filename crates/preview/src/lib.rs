@@ -32,6 +32,7 @@ pub mod command;
 mod engine;
 mod frame;
 mod http;
+mod reply;
 mod shared;
 pub mod source;
 pub mod view;

@@ -13,7 +13,7 @@ use tiny_http::{Request, Response};
 use tungstenite::protocol::Role;
 use tungstenite::{Message, WebSocket};
 
-use crate::http::{error, header, with_headers};
+use crate::reply::{error, header, with_headers};
 use crate::shared::{ClientGuard, Shared};
 
 /// Silence after which a ping checks the page is still there.

@@ -2,7 +2,7 @@
 //! groups, Cryptomatte, deep samples, a depth holdout), the volumes' names
 //! the ID mattes are keyed by, and how the layers are written.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use cirrus_deep_exr::DeepImage;
@@ -12,7 +12,6 @@ use cirrus_render::{DepthHoldout, IntegratorKind, Layers, RenderSettings, Render
 
 use crate::description::SceneDescription;
 use crate::error::{Error, Result};
-use crate::output::Outputs;
 
 /// Cryptomatte layer of the volume instances' names.
 pub const OBJECT_LAYER: &str = "CryptoObject";
@@ -111,31 +110,30 @@ fn check_name(n: &str) -> Result<()> {
     Ok(())
 }
 
-/// `FILE.exr[:CHANNEL]` split into the file and the channel.
-pub fn split_depth_spec(spec: &str) -> (PathBuf, Option<String>) {
-    match spec.rsplit_once(':') {
-        Some((file, channel)) if !channel.is_empty() && !channel.contains('/') => {
-            (PathBuf::from(file), Some(channel.to_string()))
-        }
-        _ => (PathBuf::from(spec), None),
-    }
+/// The compositing layers a scene's outputs ask the render to keep.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct LayerRequest {
+    pub light_groups: bool,
+    pub cryptomatte: bool,
+    /// Samples per deep pixel, when a deep file is written.
+    pub deep_samples: Option<u32>,
 }
 
-/// Sets the compositing layers `outputs` asks for and reads the depth
-/// holdout, if any, for a camera of `res`. Refuses what the integrator
-/// cannot give and light-group names that clash with other layers.
+/// Sets the compositing layers `asked` and reads the depth holdout, if
+/// any, for a camera of `res`. Refuses what the integrator cannot give and
+/// light-group names that clash with other layers.
 pub(crate) fn configure(
     settings: &mut RenderSettings,
-    outputs: &Outputs,
+    asked: LayerRequest,
     desc: &SceneDescription,
     res: (u32, u32),
 ) -> Result<()> {
     let c = &mut settings.compositing;
-    if outputs.light_groups {
+    if asked.light_groups {
         c.light_groups = DEFAULT_LIGHT_GROUPS.iter().map(|s| s.to_string()).collect();
     }
-    c.cryptomatte = outputs.cryptomatte;
-    c.deep_samples = outputs.deep.as_ref().map(|_| outputs.deep_samples);
+    c.cryptomatte = asked.cryptomatte;
+    c.deep_samples = asked.deep_samples;
     let needs_paths = c.cryptomatte || c.deep_samples.is_some();
     if needs_paths && settings.integrator != IntegratorKind::Path {
         return Err(Error::input(format!(
@@ -146,7 +144,7 @@ pub(crate) fn configure(
     }
     check_group_names(&settings.compositing.light_groups)?;
     if let Some(spec) = &desc.render.holdout_depth {
-        let (file, channel) = split_depth_spec(spec);
+        let (file, channel) = crate::parse::split_depth_spec(spec);
         if !file.exists() {
             return Err(Error::file(format!(
                 "{}: holdout depth image not found",
@@ -176,11 +174,9 @@ pub fn check_group_names(groups: &[String]) -> Result<()> {
 /// The AOVs written as AOV layers: without the two that only switch
 /// layers on, and without `emission` when the `emission` light group
 /// (the same estimate) is written.
-pub(crate) fn written_aovs(outputs: &Outputs, layers: Option<&Layers>) -> Vec<Aov> {
+pub(crate) fn written_aovs(aovs: &[Aov], layers: Option<&Layers>) -> Vec<Aov> {
     let group_emission = layers.is_some_and(|l| l.group_names.iter().any(|g| g == "emission"));
-    outputs
-        .aovs
-        .iter()
+    aovs.iter()
         .copied()
         .filter(|a| !matches!(a, Aov::Lights | Aov::Cryptomatte))
         .filter(|a| !(group_emission && *a == Aov::Emission))
@@ -193,8 +189,9 @@ type Channels = Vec<(String, Vec<f32>)>;
 type Attributes = Vec<(String, String)>;
 
 /// The light-group and Cryptomatte channels of a render, with the
-/// Cryptomatte header attributes.
-pub(crate) fn layer_channels(r: &Rendered, outputs: &Outputs) -> (Channels, Attributes) {
+/// Cryptomatte header attributes; `names` are the volumes' object and
+/// asset names, by their index in the scene.
+pub(crate) fn layer_channels(r: &Rendered, names: [&[String]; 2]) -> (Channels, Attributes) {
     let (mut channels, mut attributes) = (Vec::new(), Vec::new());
     let Some(layers) = &r.layers else {
         return (channels, attributes);
@@ -208,8 +205,7 @@ pub(crate) fn layer_channels(r: &Rendered, outputs: &Outputs) -> (Channels, Attr
         }
     }
     if !layers.coverage.is_empty() {
-        let objects = &outputs.object_names;
-        let assets = &outputs.asset_names;
+        let [objects, assets] = names;
         channels.extend(cryptomatte::channels(
             OBJECT_LAYER,
             &layers.coverage,
@@ -364,15 +360,5 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("\"key\" is named twice"));
-    }
-
-    #[test]
-    fn a_depth_spec_splits_at_its_channel() {
-        assert_eq!(split_depth_spec("z.exr"), (PathBuf::from("z.exr"), None));
-        let (f, c) = split_depth_spec("dir/z.exr:ViewLayer.Depth.Z");
-        assert_eq!(
-            (f, c.as_deref()),
-            (PathBuf::from("dir/z.exr"), Some("ViewLayer.Depth.Z"))
-        );
     }
 }

@@ -26,7 +26,7 @@ use cirrus_render::{
     VelocityUnit,
 };
 
-use crate::description::Colour;
+use crate::values::Colour;
 
 /// One declared setting, for documentation and tests.
 #[derive(Clone, Debug, PartialEq)]

@@ -17,12 +17,15 @@ use cirrus_render::{
     IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward, TransmittanceEstimator,
     VelocityUnit,
 };
-use serde::Deserialize;
 
 use crate::declare::declare_settings;
 use crate::error::{Error, Result};
 #[cfg(feature = "clap")]
 use crate::parse;
+use crate::values::{check_samples, finite_matrix};
+pub use crate::values::{
+    AxisAngle, BlackbodySpec, Colour, FileSample, Matrix, MatrixSample, ScaleSpec, TransformSpec,
+};
 
 declare_settings! {
     /// `[output]`: where the image goes.
@@ -299,100 +302,6 @@ declare_settings! {
     }
 }
 
-/// A 4x4 matrix as rows (column vectors: the translation is the last column).
-pub type Matrix = [[f64; 4]; 4];
-
-/// A matrix at a time in frames.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct MatrixSample {
-    pub time: f64,
-    pub matrix: Matrix,
-}
-
-/// A volume file from a time on (held until the next sample).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct FileSample {
-    pub time: f64,
-    pub file: PathBuf,
-}
-
-/// A number or an RGB triple.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
-#[serde(untagged)]
-pub enum Colour {
-    Grey(f32),
-    Rgb([f32; 3]),
-}
-
-impl Colour {
-    pub fn rgb(self) -> [f32; 3] {
-        match self {
-            Colour::Grey(v) => [v; 3],
-            Colour::Rgb(c) => c,
-        }
-    }
-
-    pub fn vec3(self) -> glam::Vec3 {
-        glam::Vec3::from_array(self.rgb())
-    }
-}
-
-/// The command-line form: `x` or `r,g,b`.
-impl std::fmt::Display for Colour {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Colour::Grey(v) => write!(f, "{v}"),
-            Colour::Rgb([r, g, b]) => write!(f, "{r},{g},{b}"),
-        }
-    }
-}
-
-/// Object to world: scale, then rotate, then translate.
-#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct TransformSpec {
-    pub translate: Option<[f64; 3]>,
-    /// Axis-angle rotation.
-    pub rotate: Option<AxisAngle>,
-    /// Euler angles in degrees, applied about X, then Y, then Z
-    /// (exclusive with `rotate`).
-    pub euler: Option<[f64; 3]>,
-    /// Uniform (a number) or per axis.
-    pub scale: Option<ScaleSpec>,
-    /// Object to world as a 4x4 matrix (rows, column vectors), exclusive
-    /// with the fields above.
-    pub matrix: Option<Matrix>,
-    /// Time-sampled object-to-world matrices (frames), interpolated between
-    /// samples (translation and scale linearly, rotation by slerp): motion
-    /// blur when the shutter is open. Exclusive with the fields above.
-    pub samples: Option<Vec<MatrixSample>>,
-}
-
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct AxisAngle {
-    pub axis: [f64; 3],
-    pub degrees: f64,
-}
-
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
-#[serde(untagged)]
-pub enum ScaleSpec {
-    Uniform(f64),
-    Axes([f64; 3]),
-}
-
-/// pbrt-v4's blackbody parameters: `Le = scale * Blackbody((T - offset) * temperature_scale)`.
-#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct BlackbodySpec {
-    pub scale: Option<f32>,
-    pub offset: Option<f32>,
-    pub temperature_scale: Option<f32>,
-}
-
 impl SceneDescription {
     /// Reads and parses `path`; errors name the file (toml's messages give
     /// the line, column and key).
@@ -432,7 +341,7 @@ impl SceneDescription {
             *map = dir.join(&*map);
         }
         if let Some(spec) = self.render.holdout_depth.as_mut() {
-            let (file, channel) = crate::compositing::split_depth_spec(spec);
+            let (file, channel) = crate::parse::split_depth_spec(spec);
             let file = dir.join(file).display().to_string();
             *spec = channel.map_or(file.clone(), |c| format!("{file}:{c}"));
         }
@@ -448,7 +357,7 @@ impl SceneDescription {
                 s.file = substitute(&s.file, frame);
             }
         }
-        crate::timeline::hold_file_samples(self);
+        self.hold_file_samples();
         if let Some(map) = self.environment.as_mut().and_then(|e| e.env_map.as_mut()) {
             *map = substitute(map, frame);
         }
@@ -466,6 +375,22 @@ impl SceneDescription {
         }
     }
 
+    /// The frame a render shows.
+    pub fn frame(&self) -> f64 {
+        self.render.frame.unwrap_or(0.0)
+    }
+
+    /// Sets each volume's `file` to its file sample held at the frame.
+    pub fn hold_file_samples(&mut self) {
+        let frame = self.frame();
+        for v in &mut self.volumes {
+            if let Some(samples) = v.file_samples.as_ref().filter(|s| !s.is_empty()) {
+                let i = samples.partition_point(|s| s.time <= frame);
+                v.file = samples[i.saturating_sub(1)].file.clone();
+            }
+        }
+    }
+
     /// What serde cannot say: exclusive fields, ordered samples.
     fn check(&self) -> std::result::Result<(), String> {
         for (i, v) in self.volumes.iter().enumerate() {
@@ -476,10 +401,90 @@ impl SceneDescription {
                     v.file.display()
                 ));
             }
-            crate::timeline::check_volume(v)
+            v.check()
                 .map_err(|e| format!("volume {} ({}): {e}", i + 1, v.file.display()))?;
         }
-        crate::timeline::check_camera(&self.camera).map_err(|e| format!("[camera] {e}"))
+        self.camera.check().map_err(|e| format!("[camera] {e}"))
+    }
+}
+
+impl VolumeSpec {
+    /// Checks the volume's transform and time-sampled fields and their
+    /// exclusions.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        let v = self;
+        let t = &v.transform;
+        let trs =
+            t.translate.is_some() || t.rotate.is_some() || t.euler.is_some() || t.scale.is_some();
+        if [trs, t.matrix.is_some(), t.samples.is_some()]
+            .iter()
+            .filter(|&&x| x)
+            .count()
+            > 1
+        {
+            return Err(
+                "give the transform as translate/rotate/scale, `matrix` or `samples`, one of them"
+                    .into(),
+            );
+        }
+        if let Some(s) = &t.samples {
+            check_samples(
+                s.iter().map(|s| (s.time, finite_matrix(&s.matrix))),
+                "transform samples",
+            )?;
+        }
+        if let Some(m) = &t.matrix {
+            if !finite_matrix(m) {
+                return Err("the transform matrix must be finite".into());
+            }
+        }
+        if let Some(s) = &v.file_samples {
+            check_samples(s.iter().map(|s| (s.time, true)), "file_samples")?;
+        }
+        Ok(())
+    }
+}
+
+impl CameraSpec {
+    /// Checks the camera's matrix, samples and lens against each other.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        let c = self;
+        let placed = c.matrix.is_some() || c.samples.is_some();
+        if placed && (c.camera_from.is_some() || c.camera_to.is_some()) {
+            return Err("give `from`/`to` or `matrix`/`samples`, not both".into());
+        }
+        if c.matrix.is_some() && c.samples.is_some() {
+            return Err("give `matrix` or `samples`, not both".into());
+        }
+        if let Some(m) = &c.matrix {
+            if !finite_matrix(m) {
+                return Err("the camera matrix must be finite".into());
+            }
+        }
+        if let Some(s) = &c.samples {
+            check_samples(
+                s.iter().map(|s| (s.time, finite_matrix(&s.matrix))),
+                "camera samples",
+            )?;
+        }
+        if c.focal_length.is_some() && c.fov.is_some() {
+            return Err("give `fov` or `focal_length`, not both".into());
+        }
+        let positive = |x: Option<f32>| x.is_none_or(|v| v.is_finite() && v > 0.0);
+        if !positive(c.focal_length)
+            || !positive(c.horizontal_aperture)
+            || !positive(c.vertical_aperture)
+        {
+            return Err("focal length and apertures must be finite and > 0".into());
+        }
+        if let Some([near, far]) = c.clipping {
+            if !(near.is_finite() && near >= 0.0 && far > near) {
+                return Err(format!(
+                    "clipping [{near}, {far}]: expected 0 <= near < far"
+                ));
+            }
+        }
+        Ok(())
     }
 }
 

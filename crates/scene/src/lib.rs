@@ -56,6 +56,7 @@ mod scene;
 mod settings;
 pub mod timeline;
 pub mod usd;
+mod values;
 
 pub use declare::{SettingInfo, Shown};
 pub use denoise::{denoise, denoise_available};

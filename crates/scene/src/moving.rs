@@ -20,7 +20,7 @@ use crate::description::{SceneDescription, VolumeSpec};
 use crate::error::{Error, Result};
 use crate::plan::{Plan, Pose, VolumeCache};
 use crate::settings::SceneSettings;
-use crate::timeline::{camera_placement, frame_of, lens_fov, matrix_at};
+use crate::timeline::{camera_placement, lens_fov, matrix_at};
 
 /// Evenly spaced maps a moving volume's shutter is tabulated at.
 const TABLE_MAPS: usize = 65;
@@ -179,7 +179,7 @@ pub fn wrap<'v>(
 pub fn camera(desc: &SceneDescription, s: &SceneSettings, centre: DVec3) -> Result<Option<Camera>> {
     let c = &desc.camera;
     let shutter = desc.render.shutter.unwrap_or([0.0, 0.0]);
-    let placement = camera_placement(c, frame_of(desc), shutter);
+    let placement = camera_placement(c, desc.frame(), shutter);
     if placement.is_none() && c.focal_length.is_none() && c.clipping.is_none() {
         return Ok(None);
     }

@@ -52,6 +52,15 @@ impl Outputs {
         }
     }
 
+    /// The compositing layers these outputs need the render to keep.
+    pub(crate) fn layer_request(&self) -> crate::compositing::LayerRequest {
+        crate::compositing::LayerRequest {
+            light_groups: self.light_groups,
+            cryptomatte: self.cryptomatte,
+            deep_samples: self.deep.as_ref().map(|_| self.deep_samples),
+        }
+    }
+
     /// Writes every output that is set.
     pub fn write(&self, rendered: &Rendered) -> Result<()> {
         let file_err = |p: &Path, e: std::io::Error| Error::file(format!("{}: {e}", p.display()));
@@ -60,8 +69,9 @@ impl Outputs {
             crate::compositing::write_deep(deep, rendered)?;
         }
         if let Some(exr) = &self.exr {
-            let aovs = crate::compositing::written_aovs(self, rendered.layers.as_ref());
-            let (extra, attributes) = crate::compositing::layer_channels(rendered, self);
+            let aovs = crate::compositing::written_aovs(&self.aovs, rendered.layers.as_ref());
+            let names = [&self.object_names[..], &self.asset_names[..]];
+            let (extra, attributes) = crate::compositing::layer_channels(rendered, names);
             write_exr_with(exr, rendered, &aovs, extra, attributes)
                 .map_err(|e| file_err(exr, e))?;
         }

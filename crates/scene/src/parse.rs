@@ -1,6 +1,8 @@
 //! The text forms of values on command lines and in scene files.
 
-use crate::description::Colour;
+use std::path::PathBuf;
+
+use crate::values::Colour;
 
 /// A colour: one finite number "x" (grey) or three "r,g,b".
 pub fn colour(s: &str) -> Result<Colour, String> {
@@ -85,8 +87,19 @@ pub fn crop(s: &str) -> Result<[u32; 4], String> {
     }
 }
 
+/// `FILE.exr[:CHANNEL]` split into the file and the channel.
+pub fn split_depth_spec(spec: &str) -> (PathBuf, Option<String>) {
+    match spec.rsplit_once(':') {
+        Some((file, channel)) if !channel.is_empty() && !channel.contains('/') => {
+            (PathBuf::from(file), Some(channel.to_string()))
+        }
+        _ => (PathBuf::from(spec), None),
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn colours_are_one_number_or_three() {
@@ -96,8 +109,6 @@ mod tests {
             assert!(colour(bad).is_err(), "{bad:?}");
         }
     }
-
-    use super::*;
 
     #[test]
     fn text_forms_parse_and_refuse() {
@@ -115,5 +126,15 @@ mod tests {
         assert!(resolution("12by4").unwrap_err().contains("WxH"));
         assert_eq!(crop("1,2,30,40").unwrap(), [1, 2, 30, 40]);
         assert!(crop("1,2,3").is_err());
+    }
+
+    #[test]
+    fn a_depth_spec_splits_at_its_channel() {
+        assert_eq!(split_depth_spec("z.exr"), (PathBuf::from("z.exr"), None));
+        let (f, c) = split_depth_spec("dir/z.exr:ViewLayer.Depth.Z");
+        assert_eq!(
+            (f, c.as_deref()),
+            (PathBuf::from("dir/z.exr"), Some("ViewLayer.Depth.Z"))
+        );
     }
 }

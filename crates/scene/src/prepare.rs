@@ -85,7 +85,7 @@ pub fn prepare<'c>(
     let shutter = settings.render.shutter;
     let moving = shutter.max_abs_time() > 0.0;
     // Time-sampled transforms read at the frame, and over the shutter.
-    let frame = crate::timeline::frame_of(desc);
+    let frame = desc.frame();
     let tracks: Vec<_> = desc
         .volumes
         .iter()

@@ -77,7 +77,7 @@ impl Scene {
         }
         description.rebase(dir);
         crate::compositing::instance_names(&description)?;
-        crate::timeline::hold_file_samples(&mut description);
+        description.hold_file_samples();
         Ok(Scene {
             description,
             placement: Placement::Volumes,
@@ -166,7 +166,7 @@ impl Scene {
         }
         crate::compositing::configure(
             &mut settings.render,
-            &outputs,
+            outputs.layer_request(),
             &self.description,
             settings.res,
         )?;

@@ -11,7 +11,8 @@
 
 use glam::{DMat4, DQuat, DVec3};
 
-use crate::description::{CameraSpec, Matrix, MatrixSample, SceneDescription, VolumeSpec};
+use crate::description::{CameraSpec, SceneDescription};
+use crate::values::{Matrix, MatrixSample};
 
 /// More samples than this inside one shutter are resampled uniformly.
 pub const MAX_SHUTTER_POSES: usize = 64;
@@ -24,11 +25,6 @@ pub fn to_dmat4(m: &Matrix) -> DMat4 {
 /// The rows of `m`.
 pub fn from_dmat4(m: DMat4) -> Matrix {
     m.transpose().to_cols_array_2d()
-}
-
-/// The frame a render shows.
-pub fn frame_of(desc: &SceneDescription) -> f64 {
-    desc.render.frame.unwrap_or(0.0)
 }
 
 /// The matrix of `samples` at `time` (clamped to the first and last).
@@ -80,116 +76,10 @@ pub fn shutter_poses(samples: &[MatrixSample], frame: f64, shutter: [f32; 2]) ->
     poses
 }
 
-/// Checks a volume's time-sampled fields and their exclusions.
-pub fn check_volume(v: &VolumeSpec) -> Result<(), String> {
-    let t = &v.transform;
-    let trs = t.translate.is_some() || t.rotate.is_some() || t.euler.is_some() || t.scale.is_some();
-    if [trs, t.matrix.is_some(), t.samples.is_some()]
-        .iter()
-        .filter(|&&x| x)
-        .count()
-        > 1
-    {
-        return Err(
-            "give the transform as translate/rotate/scale, `matrix` or `samples`, one of them"
-                .into(),
-        );
-    }
-    if let Some(s) = &t.samples {
-        check_samples(
-            s.iter().map(|s| (s.time, finite_matrix(&s.matrix))),
-            "transform samples",
-        )?;
-    }
-    if let Some(m) = &t.matrix {
-        if !finite_matrix(m) {
-            return Err("the transform matrix must be finite".into());
-        }
-    }
-    if let Some(s) = &v.file_samples {
-        check_samples(s.iter().map(|s| (s.time, true)), "file_samples")?;
-    }
-    Ok(())
-}
-
-/// Checks the camera's matrix, samples and lens against each other.
-pub fn check_camera(c: &CameraSpec) -> Result<(), String> {
-    let placed = c.matrix.is_some() || c.samples.is_some();
-    if placed && (c.camera_from.is_some() || c.camera_to.is_some()) {
-        return Err("give `from`/`to` or `matrix`/`samples`, not both".into());
-    }
-    if c.matrix.is_some() && c.samples.is_some() {
-        return Err("give `matrix` or `samples`, not both".into());
-    }
-    if let Some(m) = &c.matrix {
-        if !finite_matrix(m) {
-            return Err("the camera matrix must be finite".into());
-        }
-    }
-    if let Some(s) = &c.samples {
-        check_samples(
-            s.iter().map(|s| (s.time, finite_matrix(&s.matrix))),
-            "camera samples",
-        )?;
-    }
-    if c.focal_length.is_some() && c.fov.is_some() {
-        return Err("give `fov` or `focal_length`, not both".into());
-    }
-    let positive = |x: Option<f32>| x.is_none_or(|v| v.is_finite() && v > 0.0);
-    if !positive(c.focal_length)
-        || !positive(c.horizontal_aperture)
-        || !positive(c.vertical_aperture)
-    {
-        return Err("focal length and apertures must be finite and > 0".into());
-    }
-    if let Some([near, far]) = c.clipping {
-        if !(near.is_finite() && near >= 0.0 && far > near) {
-            return Err(format!(
-                "clipping [{near}, {far}]: expected 0 <= near < far"
-            ));
-        }
-    }
-    Ok(())
-}
-
-fn finite_matrix(m: &Matrix) -> bool {
-    m.iter().flatten().all(|x| x.is_finite())
-}
-
-fn check_samples(samples: impl Iterator<Item = (f64, bool)>, what: &str) -> Result<(), String> {
-    let mut last = f64::NEG_INFINITY;
-    let mut count = 0;
-    for (time, ok) in samples {
-        if !time.is_finite() || time <= last {
-            return Err(format!("{what}: times must be finite and increasing"));
-        }
-        if !ok {
-            return Err(format!("{what}: the matrix at time {time} is not finite"));
-        }
-        last = time;
-        count += 1;
-    }
-    if count == 0 {
-        return Err(format!("{what}: give at least one sample"));
-    }
-    Ok(())
-}
-
-/// Sets each volume's `file` to its file sample held at the frame.
-pub fn hold_file_samples(desc: &mut SceneDescription) {
-    let frame = frame_of(desc);
-    for v in &mut desc.volumes {
-        if let Some(samples) = v.file_samples.as_ref().filter(|s| !s.is_empty()) {
-            let i = samples.partition_point(|s| s.time <= frame);
-            v.file = samples[i.saturating_sub(1)].file.clone();
-        }
-    }
-}
-
 /// The description with every volume's transform read at the frame
 /// (`transform.samples` become `transform.matrix`).
 pub fn at_frame(desc: &SceneDescription) -> SceneDescription {
-    let frame = frame_of(desc);
+    let frame = desc.frame();
     let mut out = desc.clone();
     for v in &mut out.volumes {
         if let Some(samples) = v.transform.samples.take() {

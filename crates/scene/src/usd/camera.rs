@@ -44,7 +44,7 @@ pub fn camera(r: &mut Reader, path: &str) -> Result<(CameraSpec, Option<[f32; 2]
         clipping: Some(clipping),
         ..Default::default()
     };
-    crate::timeline::check_camera(&spec).map_err(|e| r.error(path, e))?;
+    spec.check().map_err(|e| r.error(path, e))?;
     let open = number("shutter:open")?.unwrap_or(0.0) as f32;
     let close = number("shutter:close")?.unwrap_or(0.0) as f32;
     let shutter = (close > open).then_some([open, close]);

@@ -97,7 +97,7 @@ pub fn read(r: &mut Reader, path: &str) -> Result<VolumeSpec> {
     }
     spec.transform = xform::transform_spec(&r.stage, path, r.time.start)?;
     material::apply(r, path, &mut spec)?;
-    crate::timeline::check_volume(&spec).map_err(|e| r.error(path, e))?;
+    spec.check().map_err(|e| r.error(path, e))?;
     Ok(spec)
 }
 

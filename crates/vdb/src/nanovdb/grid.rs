@@ -2,48 +2,16 @@
 //! type) here, then the tree (`TreeData`, root table, internal nodes and
 //! leaves) in `walk.rs`.
 
+use super::buf::Buf;
 use super::layout::{self, Layout};
 use super::walk::build_tree;
 use crate::error::{corrupt, unsupported, KindResult};
 use crate::grid::{Grid, GridClass};
 use crate::metadata::MetaValue;
 use crate::transform::{MapKind, Transform};
-use crate::Coord;
 use glam::{DMat4, DVec4};
 
 pub const GRID_MAGICS: [&[u8; 8]; 2] = [b"NanoVDB0", b"NanoVDB1"];
-
-/// A bounds-checked view of a grid buffer.
-#[derive(Clone, Copy)]
-pub struct Buf<'a>(pub &'a [u8]);
-
-impl<'a> Buf<'a> {
-    pub fn bytes(&self, off: usize, len: usize, what: &str) -> KindResult<&'a [u8]> {
-        off.checked_add(len)
-            .and_then(|end| self.0.get(off..end))
-            .ok_or_else(|| {
-                corrupt(format!(
-                    "{what} (bytes {off}..+{len}) lies outside the {}-byte grid buffer",
-                    self.0.len()
-                ))
-            })
-    }
-    fn array<const N: usize>(&self, off: usize, what: &str) -> KindResult<[u8; N]> {
-        Ok(self.bytes(off, N, what)?.try_into().unwrap())
-    }
-    pub fn u32(&self, off: usize, what: &str) -> KindResult<u32> {
-        Ok(u32::from_le_bytes(self.array(off, what)?))
-    }
-    pub fn u64(&self, off: usize, what: &str) -> KindResult<u64> {
-        Ok(u64::from_le_bytes(self.array(off, what)?))
-    }
-    pub fn i64(&self, off: usize, what: &str) -> KindResult<i64> {
-        Ok(i64::from_le_bytes(self.array(off, what)?))
-    }
-    fn f64(&self, off: usize, what: &str) -> KindResult<f64> {
-        Ok(f64::from_le_bytes(self.array(off, what)?))
-    }
-}
 
 /// `major.minor.patch` of a packed NanoVDB `Version` (11 + 11 + 10 bits).
 pub fn version_parts(v: u32) -> (u32, u32, u32) {
@@ -135,21 +103,6 @@ fn read_transform(b: Buf) -> KindResult<Transform> {
         .ok_or_else(|| corrupt("NanoVDB map is singular or not finite"))
 }
 
-/// Decodes a root key: 21 bits per axis, x highest, each the coordinate as an
-/// unsigned 32-bit integer shifted right by 12 (so negative coordinates wrap).
-pub fn key_origin(key: u64) -> KindResult<Coord> {
-    const FIELD: u64 = (1 << 21) - 1;
-    let (x, y, z) = ((key >> 42) & FIELD, (key >> 21) & FIELD, key & FIELD);
-    // A 32-bit coordinate shifted by 12 leaves 20 bits: the top bit of each field, and bit 63, are unused.
-    if key >> 63 != 0 || (x | y | z) >> 20 != 0 {
-        return Err(corrupt(format!(
-            "root key {key:#018x} is not a coordinate key"
-        )));
-    }
-    let axis = |v: u64| ((v as u32) << 12) as i32;
-    Ok(Coord::new(axis(x), axis(y), axis(z)))
-}
-
 /// Parses grid buffer `buf` (exactly `GridData::mGridSize` bytes) into a grid named `name`.
 pub fn parse_grid(buf: &[u8], name: String) -> KindResult<Grid> {
     let b = Buf(buf);
@@ -195,29 +148,4 @@ pub fn parse_grid(buf: &[u8], name: String) -> KindResult<Grid> {
         tree,
         half_float: lay.quantised,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn root_keys_decode_negative_and_positive_origins() {
-        let key = |x: i32, y: i32, z: i32| {
-            ((x as u32 >> 12) as u64) << 42
-                | ((y as u32 >> 12) as u64) << 21
-                | (z as u32 >> 12) as u64
-        };
-        for c in [
-            (0, 0, 0),
-            (4096, 0, 8192),
-            (-4096, 4096, -8192),
-            (i32::MIN, i32::MAX & !4095, -4096),
-        ] {
-            let k = key(c.0, c.1, c.2);
-            assert_eq!(key_origin(k).unwrap(), Coord::new(c.0, c.1, c.2));
-        }
-        assert!(key_origin(1 << 63).is_err());
-        assert!(key_origin(1 << 20).is_err());
-    }
 }

@@ -45,6 +45,7 @@
 //! set). Others (Half, Int16, UInt32, UInt8, RGBA8, Vec4f/d, index and point
 //! grids) are listed but refused on read with the type's name.
 
+mod buf;
 mod grid;
 mod layout;
 mod walk;
@@ -52,7 +53,8 @@ mod walk;
 use crate::error::{corrupt, unsupported, ErrorKind, KindResult};
 use crate::grid::{Grid, GridInfo};
 use crate::source::FileSource;
-use grid::{version_parts, version_string, Buf};
+use buf::Buf;
+use grid::{version_parts, version_string};
 use layout::{FILE_HEADER_SIZE, FILE_META_SIZE, GRID_DATA_SIZE, TREE_DATA_SIZE};
 use std::collections::HashMap;
 

@@ -7,7 +7,7 @@
 //! so a corrupt buffer can neither loop nor make the reader allocate more than
 //! a small multiple of its own size. Leaves are decoded in parallel at the end.
 
-use super::grid::{key_origin, Buf};
+use super::buf::Buf;
 use super::layout::{self, Layout, LeafCodec};
 use crate::error::{corrupt, KindResult};
 use crate::grid::GridTree;
@@ -334,6 +334,21 @@ impl<'a, V: Value> Walk<'a, V> {
     }
 }
 
+/// Decodes a root key: 21 bits per axis, x highest, each the coordinate as an
+/// unsigned 32-bit integer shifted right by 12 (so negative coordinates wrap).
+pub fn key_origin(key: u64) -> KindResult<Coord> {
+    const FIELD: u64 = (1 << 21) - 1;
+    let (x, y, z) = ((key >> 42) & FIELD, (key >> 21) & FIELD, key & FIELD);
+    // A 32-bit coordinate shifted by 12 leaves 20 bits: the top bit of each field, and bit 63, are unused.
+    if key >> 63 != 0 || (x | y | z) >> 20 != 0 {
+        return Err(corrupt(format!(
+            "root key {key:#018x} is not a coordinate key"
+        )));
+    }
+    let axis = |v: u64| ((v as u32) << 12) as i32;
+    Ok(Coord::new(axis(x), axis(y), axis(z)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -485,5 +500,25 @@ mod tests {
             }
         }
         assert!(ok > 0 && err > 0, "{ok} parsed, {err} refused");
+    }
+
+    #[test]
+    fn root_keys_decode_negative_and_positive_origins() {
+        let key = |x: i32, y: i32, z: i32| {
+            ((x as u32 >> 12) as u64) << 42
+                | ((y as u32 >> 12) as u64) << 21
+                | (z as u32 >> 12) as u64
+        };
+        for c in [
+            (0, 0, 0),
+            (4096, 0, 8192),
+            (-4096, 4096, -8192),
+            (i32::MIN, i32::MAX & !4095, -4096),
+        ] {
+            let k = key(c.0, c.1, c.2);
+            assert_eq!(key_origin(k).unwrap(), Coord::new(c.0, c.1, c.2));
+        }
+        assert!(key_origin(1 << 63).is_err());
+        assert!(key_origin(1 << 20).is_err());
     }
 }
