@@ -76,14 +76,14 @@ pub const DEFAULT_RADIUS: usize = 8;
 /// this at every point.
 pub const BIAS_SCALE: f64 = 0.629_960_524_947_436_6;
 
-/// Standard errors of the cross-validated bias estimate discounted from it.
-/// A trade measured on the sweeps of BENCHMARKS.md (thick, default and
-/// sky-lit clouds at 128x128, 16-2048 spp; the default cloud at 64x64):
-/// 0 left the blend 1-2% above the plain denoised image at 16-256 spp on
-/// the thick cloud; 1 brought that to 0.97-1.00 but left the blend 9-31%
-/// above the noisy image at 512-2048 spp on the 64x64 cloud, where the
-/// denoiser's bias sits in few pixels of a window; 1/2 gave 0.99-1.00
-/// and 1.00-1.16 there.
+/// Standard errors of the cross-validated bias estimate (the halves' noise
+/// in it) discounted from it. A trade measured on the sweeps of
+/// BENCHMARKS.md (thick, default and sky-lit clouds at 128x128, 16-2048
+/// spp; the default cloud at 64x64): 0 left the blend 1-2% above the plain
+/// denoised image at 16-256 spp on the thick cloud; 2 brought that to
+/// 0.97-0.99 but left the blend 11-30% above the noisy image at 512-2048
+/// spp on the 64x64 cloud, where the denoiser's bias sits in few pixels of
+/// a window; 1/2 gave 0.99-1.00 and 0.97-1.11 there.
 pub const BIAS_EVIDENCE: f64 = 0.5;
 
 /// The error terms of one pixel, summed over its channels.
@@ -97,9 +97,9 @@ struct Terms {
     covariance: f64,
     /// A denoised half's whole error (`MSE(D_A)`), cross-validated.
     denoised: f64,
-    /// The square of `denoised` (summed over a window: the spread of the
-    /// cross-validated terms, hence the standard error of their sum).
-    denoised_sq: f64,
+    /// The variance the halves' noise gives `denoised` (summed over a
+    /// window: the squared standard error of the window's estimate).
+    denoised_noise: f64,
     /// 1 where the pixel's samples allow the terms (both halves hold
     /// samples), else 0 and the other terms 0.
     valid: f64,
@@ -127,9 +127,15 @@ impl Terms {
             t.noisy += s2 / n;
             t.residual += 0.5 * (da - db).powi(2);
             t.covariance += 0.5 * (a - b) * (da - db);
-            t.denoised += 0.5 * ((da - b).powi(2) - s2 / nb + (db - a).powi(2) - s2 / na);
+            let (va, vb) = (s2 / na, s2 / nb);
+            let (ta, tb) = ((da - b).powi(2) - vb, (db - a).powi(2) - va);
+            t.denoised += 0.5 * (ta + tb);
+            // (d - e)^2 - v for a denoised error d and a half's noise e of
+            // variance v varies by 2 v^2 + 4 v d^2 (e taken as normal); d^2
+            // is estimated by the term itself, clamped at 0.
+            let noise = |v: f64, d2: f64| 2.0 * v * v + 4.0 * v * d2.max(0.0);
+            t.denoised_noise += 0.25 * (noise(vb, ta) + noise(va, tb));
         }
-        t.denoised_sq = t.denoised * t.denoised;
         t
     }
 
@@ -139,19 +145,19 @@ impl Terms {
             self.residual,
             self.covariance,
             self.denoised,
-            self.denoised_sq,
+            self.denoised_noise,
             self.valid,
         ]
     }
 
     fn from_array(a: [f64; Self::COUNT]) -> Self {
-        let [noisy, residual, covariance, denoised, denoised_sq, valid] = a;
+        let [noisy, residual, covariance, denoised, denoised_noise, valid] = a;
         Self {
             noisy,
             residual,
             covariance,
             denoised,
-            denoised_sq,
+            denoised_noise,
             valid,
         }
     }
@@ -163,13 +169,13 @@ impl Terms {
         if self.valid == 0.0 {
             return 0.0;
         }
-        // The cross-validated error's standard error over the window (its
-        // terms' spread, the pixels taken as independent): only the bias
-        // the data shows beyond BIAS_EVIDENCE of it is counted, so where
-        // the estimate is noisy (few samples, heavy tails) the denoised
-        // image keeps its weight.
-        let spread = self.denoised_sq - self.denoised * self.denoised / self.valid;
-        let standard_error = spread.max(0.0).sqrt();
+        // The cross-validated error's standard error over the window from
+        // the halves' noise alone (the pixels taken as independent; not
+        // the terms' spread, which counts the bias's own variation across
+        // the window as uncertainty): only the bias the data shows beyond
+        // BIAS_EVIDENCE of it is counted, so where the estimate is noisy
+        // (few samples, heavy tails) the denoised image keeps its weight.
+        let standard_error = self.denoised_noise.max(0.0).sqrt();
         let evidence = self.denoised - self.residual - BIAS_EVIDENCE * standard_error;
         let bias2 = BIAS_SCALE * evidence.max(0.0);
         let mse_denoised = bias2 + 0.5 * self.residual.max(0.0);
