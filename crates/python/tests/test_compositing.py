@@ -140,3 +140,21 @@ def test_light_groups_and_holdout_depth_by_keyword(tmp_path):
         cirrus.render(CLOUD, res="32x24", spp=1, holdout_depth=f"{near}:nope")
     with pytest.raises(OSError, match="absent.exr"):
         cirrus.render(CLOUD, res="32x24", spp=1, holdout_depth=tmp_path / "absent.exr")
+
+
+def test_denoised_layers_read_back_and_make_up_the_blend(tmp_path):
+    """`denoise=True` writes the noisy image, the plain denoised one and the
+    noisy image's weight beside the blended RGB; read through OpenEXR's own
+    bindings, RGB is `w * noisy + (1 - w) * denoised` per pixel."""
+    out = tmp_path / "dn.exr"
+    cirrus.render(CLOUD, res="48x32", spp=32, seed=3, denoise=True, output=out)
+    _, ch = read_exr(out)
+    rgb = np.stack([ch[c] for c in "RGB"], axis=-1).astype(np.float64)
+    noisy = np.stack([ch[f"noisy.{c}"] for c in "RGB"], axis=-1).astype(np.float64)
+    plain = np.stack([ch[f"denoised.{c}"] for c in "RGB"], axis=-1).astype(np.float64)
+    w = ch["blend.weight"].astype(np.float64)[..., None]
+    assert np.all((w >= 0.0) & (w <= 1.0))
+    assert np.abs(rgb - (w * noisy + (1.0 - w) * plain)).max() <= 1e-5 * max(rgb.max(), 1.0)
+    # Both images take part somewhere, and the denoiser did change the image.
+    assert (w < 0.5).any() and (w > 0.5).any()
+    assert np.abs(plain - noisy).max() > 1e-3

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use cirrus_denoise::blend::{self, BlendInputs};
 use cirrus_denoise::Denoiser;
-use cirrus_render::{Denoised, Rendered};
+use cirrus_render::{Denoised, Halves, Rendered};
 
 use crate::error::{Error, Result};
 
@@ -53,7 +53,11 @@ pub fn denoise(r: &mut Rendered) -> Result<()> {
     };
     let noisy: Vec<[f32; 3]> = r.image.rgba.iter().map(|p| [p[0], p[1], p[2]]).collect();
     let plain = filter(&noisy)?;
-    let noisy_weight = match &r.halves {
+    // A pixel with samples in one half only (1 spp) allows no estimate and
+    // gets the denoised image; where none has two, the halves are not
+    // filtered at all.
+    let two_halves = |h: &&Halves| h.samples.iter().any(|&[a, b]| a > 0 && b > 0);
+    let noisy_weight = match r.halves.as_ref().filter(two_halves) {
         Some(halves) => {
             let variance: Vec<[f32; 3]> = r
                 .image
