@@ -281,12 +281,11 @@ fn run_case(case: &Case) -> Result<(CaseResult, RenderStats), Box<dyn std::error
         RES,
         RES,
     );
-    let lights = Lights {
-        sun: case
-            .sun
+    let lights = Lights::sun_and_sky(
+        case.sun
             .then(|| Sun::new(Vec3::new(0.3, -0.8, 0.5), Vec3::splat(3.0), 0.0)),
-        environment: Some(Environment::new(Vec3::ONE)),
-    };
+        Some(Environment::new(Vec3::ONE)),
+    );
     let albedo = if case.expected.is_some() { 0.0 } else { 0.8 };
     let scene = Scene {
         media: Volumes::from(Medium::new(field, case.scale, Vec3::splat(albedo), 0.5)),

@@ -165,9 +165,9 @@ transform = {{ translate = [5, 0, 0], euler = [0, 30, 0] }}
     assert_eq!(st["width"], 16);
     assert_eq!(st["grids_loaded"], 1, "one grid, shared by both instances");
     assert_eq!(st["emission_lookups"], 0);
-    assert_eq!(st["env_samples"], 0);
-    assert_eq!(st["nee_rays_env"], 0);
-    assert!(st["nee_rays_sun"].as_u64().unwrap() > 0);
+    assert_eq!(st["dome_samples"], 0);
+    assert_eq!(st["nee_rays_dome"], 0);
+    assert!(st["nee_rays_distant"].as_u64().unwrap() > 0);
     // Only the density grid's bytes: the file holds four grids.
     let file_len = std::fs::metadata(data.join("multi_grid.vdb"))
         .unwrap()

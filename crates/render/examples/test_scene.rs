@@ -31,10 +31,10 @@ fn main() -> std::io::Result<()> {
     let scene = Scene {
         media: Volumes::from(Medium::new(field, 40.0, Vec3::splat(0.98), 0.6)),
         camera: Camera::framing(bounds, size, size),
-        lights: Lights {
-            sun: Some(Sun::new(Vec3::new(-0.4, -1.0, -0.3), Vec3::splat(3.0), 0.0)),
-            environment: Some(Environment::new(Vec3::new(0.25, 0.35, 0.5))),
-        },
+        lights: Lights::sun_and_sky(
+            Some(Sun::new(Vec3::new(-0.4, -1.0, -0.3), Vec3::splat(3.0), 0.0)),
+            Some(Environment::new(Vec3::new(0.25, 0.35, 0.5))),
+        ),
     };
     for integrator in [
         IntegratorKind::Path,

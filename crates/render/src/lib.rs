@@ -79,7 +79,7 @@ pub use adaptive::Adaptive;
 pub use blackbody::Blackbody;
 pub use camera::Camera;
 pub use camera_motion::{CameraMotion, CameraPose};
-pub use compositing::{Compositing, DepthHoldout, Layers, LightGroup};
+pub use compositing::{Compositing, DepthHoldout, Layers};
 pub use control::RenderControl;
 pub use env_map::EnvMap;
 pub use error::{Error, Result};
@@ -88,7 +88,7 @@ pub use integrator::{
     AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, LightSampling,
     PathTracer, RayMarcher, Sample, Sunward, TwoPassMarcher,
 };
-pub use light::{Environment, Lights, Sun};
+pub use light::{Environment, Light, LightKind, Lights, Sun};
 pub use medium::{
     Bounds3, BrickField, DensityField, Emission, Extinction, GlobalMedia, Interaction,
     MajorantSegment, Media, Medium, MediumError, Velocity, VelocityUnit,

@@ -1,6 +1,10 @@
-//! Lights at infinity: a directional sun (optionally a small disc) and an
-//! environment, constant or an importance-sampled HDR map. Absent lights
-//! are `None` in [`Lights`] and cost nothing: no samples, no shadow rays.
+//! The scene's lights, as a list: distant lights (a direction, optionally
+//! a small disc: the sun, the moon) and domes (light from every direction
+//! at infinity, constant or an importance-sampled HDR map). A light that
+//! delivers nothing is dropped by [`Lights::pruned`] and costs nothing: no
+//! samples, no shadow rays. Each light is tagged with the light group its
+//! contributions go to; the integrators never ask how many lights there
+//! are or of which kind, only for the list and each light's group.
 
 use std::f32::consts::PI;
 use std::sync::Arc;
@@ -187,20 +191,207 @@ impl Environment {
     }
 }
 
-/// The scene's lights; `None` means absent.
-#[derive(Clone, Debug, Default)]
+/// One light of the scene.
+#[derive(Clone, Debug)]
+pub enum Light {
+    /// Light arriving along one direction, or from a small disc about it.
+    Distant(Sun),
+    /// Light arriving from every direction.
+    Dome(Environment),
+}
+
+impl From<Sun> for Light {
+    fn from(sun: Sun) -> Self {
+        Self::Distant(sun)
+    }
+}
+
+impl From<Environment> for Light {
+    fn from(env: Environment) -> Self {
+        Self::Dome(env)
+    }
+}
+
+/// What a light is, for counters and the default light groups.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightKind {
+    Distant = 0,
+    Dome = 1,
+}
+
+impl Light {
+    pub fn kind(&self) -> LightKind {
+        match self {
+            Self::Distant(_) => LightKind::Distant,
+            Self::Dome(_) => LightKind::Dome,
+        }
+    }
+
+    /// The luminance of a distant light's irradiance or of a dome's mean
+    /// radiance: what a light choice weighs it by, times the phase
+    /// function toward a distant light.
+    pub fn luminance(&self) -> f32 {
+        match self {
+            Self::Distant(sun) => crate::spectrum::luminance(sun.irradiance()),
+            Self::Dome(env) => crate::spectrum::luminance(env.mean_radiance()),
+        }
+    }
+
+    /// Whether it delivers no light at all.
+    pub fn is_black(&self) -> bool {
+        match self {
+            Self::Distant(sun) => sun.irradiance.max_element() <= 0.0,
+            Self::Dome(env) => env.is_black(),
+        }
+    }
+
+    /// A direction toward the light from two uniform numbers.
+    #[inline]
+    pub fn sample(&self, u1: f32, u2: f32) -> LightSample {
+        match self {
+            Self::Distant(sun) => sun.sample(u1, u2),
+            Self::Dome(env) => env.sample(u1, u2),
+        }
+    }
+
+    /// Radiance reaching a ray that escapes along `dir` and the density
+    /// with which [`sample`](Self::sample) would have drawn `dir`; `None`
+    /// where the light is not seen that way (outside a disc, or a delta
+    /// light, which no direction hits).
+    #[inline]
+    pub fn escaped(&self, dir: Vec3) -> Option<(Vec3, f32)> {
+        match self {
+            Self::Distant(sun) => sun.hit(dir),
+            Self::Dome(env) => Some(env.eval(dir)),
+        }
+    }
+}
+
+/// The light group of each default kind and of the media's emission:
+/// indices into [`crate::compositing::DEFAULT_LIGHT_GROUPS`].
+const DEFAULT_GROUP_DISTANT: u8 = 0;
+const DEFAULT_GROUP_DOME: u8 = 1;
+const DEFAULT_GROUP_EMISSION: u8 = 2;
+
+/// The scene's lights, each with the light group (an index into the
+/// render's light-group layers) its light is tagged with.
+#[derive(Clone, Debug)]
 pub struct Lights {
-    pub sun: Option<Sun>,
-    pub environment: Option<Environment>,
+    list: Vec<Light>,
+    groups: Vec<u8>,
+    emission_group: u8,
+    /// Each light's [`Light::luminance`], which light choices weigh at
+    /// every vertex.
+    luminance: Vec<f32>,
+}
+
+impl Default for Lights {
+    fn default() -> Self {
+        Self::new([])
+    }
+}
+
+impl FromIterator<Light> for Lights {
+    fn from_iter<I: IntoIterator<Item = Light>>(iter: I) -> Self {
+        Self::new(iter)
+    }
 }
 
 impl Lights {
-    /// Drops lights that deliver nothing (zero irradiance or radiance), so
-    /// they cost nothing either.
-    pub fn pruned(self) -> Self {
+    /// `lights` in order, grouped by kind: distant lights in the layer
+    /// `sun`, domes in `sky`, emission in `emission`
+    /// ([`crate::compositing::DEFAULT_LIGHT_GROUPS`]).
+    pub fn new(lights: impl IntoIterator<Item = Light>) -> Self {
+        let list: Vec<Light> = lights.into_iter().collect();
+        let groups = list
+            .iter()
+            .map(|l| match l.kind() {
+                LightKind::Distant => DEFAULT_GROUP_DISTANT,
+                LightKind::Dome => DEFAULT_GROUP_DOME,
+            })
+            .collect();
+        Self::from_parts(list, groups, DEFAULT_GROUP_EMISSION)
+    }
+
+    fn from_parts(list: Vec<Light>, groups: Vec<u8>, emission_group: u8) -> Self {
+        let luminance = list.iter().map(Light::luminance).collect();
         Self {
-            sun: self.sun.filter(|s| s.irradiance.max_element() > 0.0),
-            environment: self.environment.filter(|e| !e.is_black()),
+            list,
+            groups,
+            emission_group,
+            luminance,
         }
+    }
+
+    /// A sun and a sky, either absent: the usual outdoor pair.
+    pub fn sun_and_sky(sun: Option<Sun>, sky: Option<Environment>) -> Self {
+        Self::new(sun.map(Light::from).into_iter().chain(sky.map(Light::from)))
+    }
+
+    /// The lights, in the order their samples are drawn.
+    #[inline]
+    pub fn iter(&self) -> std::slice::Iter<'_, Light> {
+        self.list.iter()
+    }
+
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    #[inline]
+    pub fn get(&self, i: usize) -> &Light {
+        &self.list[i]
+    }
+
+    /// [`Light::luminance`] of light `i`.
+    #[inline]
+    pub fn luminance(&self, i: usize) -> f32 {
+        self.luminance[i]
+    }
+
+    /// The light group light `i` is tagged with.
+    #[inline]
+    pub fn group(&self, i: usize) -> usize {
+        usize::from(self.groups[i])
+    }
+
+    /// The light group the media's emission is tagged with.
+    #[inline]
+    pub fn emission_group(&self) -> usize {
+        usize::from(self.emission_group)
+    }
+
+    /// The distant lights with their indices.
+    pub fn distant(&self) -> impl Iterator<Item = (usize, &Sun)> {
+        self.list.iter().enumerate().filter_map(|(i, l)| match l {
+            Light::Distant(sun) => Some((i, sun)),
+            Light::Dome(_) => None,
+        })
+    }
+
+    /// The domes.
+    pub fn domes(&self) -> impl Iterator<Item = &Environment> {
+        self.list.iter().filter_map(|l| match l {
+            Light::Dome(env) => Some(env),
+            Light::Distant(_) => None,
+        })
+    }
+
+    /// Drops lights that deliver nothing (zero irradiance or radiance), so
+    /// they cost nothing either; the others keep their order and groups.
+    pub fn pruned(self) -> Self {
+        let (list, groups) = self
+            .list
+            .into_iter()
+            .zip(self.groups)
+            .filter(|(l, _)| !l.is_black())
+            .unzip();
+        Self::from_parts(list, groups, self.emission_group)
     }
 }

@@ -28,10 +28,10 @@
 //! | draw | dims | where |
 //! |---|---|---|
 //! | free-flight distance | 1 | the first optical depth of the delta-tracking walk |
-//! | sun direction | 2 | next-event estimation of the sun |
-//! | sun shadow ray | 1 | the first optical depth of its transmittance walk |
-//! | sky direction | 2 | next-event estimation of the environment |
-//! | sky shadow ray | 1 | the first optical depth of its transmittance walk |
+//! | first light sample's direction | 2 | next-event estimation of the first light the vertex samples |
+//! | first light sample's shadow ray | 1 | the first optical depth of its transmittance walk |
+//! | second light sample's direction | 2 | ... of the second light it samples (every light sampled, or a disc's floor) |
+//! | second light sample's shadow ray | 1 | ... |
 //! | phase direction | 2 | the scattered direction |
 //! | Russian roulette | 1 | the path's survival |
 //!
@@ -146,16 +146,22 @@ impl SamplerKind {}
 /// come from Sobol points; later ones use the hashed stream.
 pub const SOBOL_VERTICES: u32 = 6;
 
+/// A vertex's light samples whose numbers come from Sobol points (a
+/// vertex samples one light, or every light, or two where a disc needs it).
+pub const STRATIFIED_LIGHT_SAMPLES: u32 = 2;
+
 /// What a number is drawn for: its place in the allocation of the
 /// module documentation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Draw {
     PixelJitter,
     FreeFlight,
-    SunDirection,
-    SunShadow,
-    SkyDirection,
-    SkyShadow,
+    /// The direction of a vertex's `k`-th light sample (counted from 0
+    /// in the order the vertex samples its lights)...
+    LightDirection(u32),
+    /// ...and the first optical depth of its shadow ray. Samples past
+    /// [`STRATIFIED_LIGHT_SAMPLES`] draw from the hashed stream.
+    LightShadow(u32),
     Phase,
     Roulette,
     /// The camera sample's shutter time (one per sample, not per vertex).
@@ -173,10 +179,9 @@ impl Draw {
             // After every per-vertex slot, so adding it moved none of them.
             Self::Time => return Some(1 + SOBOL_VERTICES * Self::PER_VERTEX),
             Self::FreeFlight => 0,
-            Self::SunDirection => 1,
-            Self::SunShadow => 2,
-            Self::SkyDirection => 3,
-            Self::SkyShadow => 4,
+            Self::LightDirection(k) if k < STRATIFIED_LIGHT_SAMPLES => 1 + 2 * k,
+            Self::LightShadow(k) if k < STRATIFIED_LIGHT_SAMPLES => 2 + 2 * k,
+            Self::LightDirection(_) | Self::LightShadow(_) => return None,
             Self::Phase => 5,
             Self::Roulette => 6,
         };

@@ -34,14 +34,15 @@ pub struct Counters {
     pub nonfinite_samples: u64,
     /// Emission grid lookups (temperature or emission) at collisions.
     pub emission_lookups: u64,
-    /// Next-event shadow rays toward the sun...
-    pub nee_rays_sun: u64,
-    /// ...and toward the environment.
-    pub nee_rays_env: u64,
-    /// Times the environment was consulted: directions sampled from it
-    /// for next-event estimation, and escaped rays looking it up.
-    pub env_samples: u64,
-    /// Directions drawn toward the sun by sunward scattering
+    /// Next-event shadow rays toward distant lights (sunward scattering's
+    /// included)...
+    pub nee_rays_distant: u64,
+    /// ...and toward domes.
+    pub nee_rays_dome: u64,
+    /// Times a dome was consulted: directions sampled from it for
+    /// next-event estimation, and escaped rays looking it up.
+    pub dome_samples: u64,
+    /// Directions drawn toward a distant light by sunward scattering
     /// (`integrator/path_sunward.rs`), each a free flight and, where it
     /// collides, a shadow ray.
     pub sunward_rays: u64,
@@ -60,9 +61,9 @@ impl AddAssign for Counters {
         self.majorant_violations += o.majorant_violations;
         self.nonfinite_samples += o.nonfinite_samples;
         self.emission_lookups += o.emission_lookups;
-        self.nee_rays_sun += o.nee_rays_sun;
-        self.nee_rays_env += o.nee_rays_env;
-        self.env_samples += o.env_samples;
+        self.nee_rays_distant += o.nee_rays_distant;
+        self.nee_rays_dome += o.nee_rays_dome;
+        self.dome_samples += o.dome_samples;
         self.sunward_rays += o.sunward_rays;
     }
 }

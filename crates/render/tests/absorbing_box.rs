@@ -56,10 +56,7 @@ fn absorbing_box_matches_beer_lambert() {
     let scene = Scene {
         media: Volumes::from(Medium::new(b, sigma, Vec3::ZERO, 0.3)),
         camera,
-        lights: Lights {
-            sun: None,
-            environment: common::env(l_env),
-        },
+        lights: Lights::sun_and_sky(None, common::env(l_env)),
     };
     let out = render(&scene, &common::settings(IntegratorKind::Path, spp, 17));
     assert_eq!(out.stats.spp, spp);

@@ -10,10 +10,10 @@ use cirrus_render::{
 use glam::Vec3;
 
 fn cloud(size: u32, sun: bool) -> Scene<Volumes<GridField>> {
-    let lights = Lights {
-        sun: if sun { common::sun(2.0) } else { None },
-        environment: common::env(Vec3::new(0.2, 0.3, 0.45)),
-    };
+    let lights = Lights::sun_and_sky(
+        if sun { common::sun(2.0) } else { None },
+        common::env(Vec3::new(0.2, 0.3, 0.45)),
+    );
     common::scene(
         common::medium(common::cloud_field(4), 8.0, 0.9, 0.5),
         size,

@@ -11,10 +11,7 @@ use glam::Vec3;
 
 #[test]
 fn a_cancelled_render_stops_within_a_few_samples_per_pixel() {
-    let lights = Lights {
-        sun: common::sun(0.0),
-        environment: common::env(Vec3::new(0.3, 0.4, 0.6)),
-    };
+    let lights = Lights::sun_and_sky(common::sun(0.0), common::env(Vec3::new(0.3, 0.4, 0.6)));
     let scene = common::scene(
         common::medium(common::cloud_field(4), 12.0, 0.9, 0.5),
         32,

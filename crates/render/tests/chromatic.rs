@@ -112,10 +112,7 @@ fn rgb_absorbing_box_renders_beer_lambert_per_channel() {
     let scene = Scene {
         media: medium,
         camera,
-        lights: Lights {
-            sun: None,
-            environment: common::env(l_env),
-        },
+        lights: Lights::sun_and_sky(None, common::env(l_env)),
     };
     let spp = 256;
     let out = render(&scene, &common::settings(IntegratorKind::Path, spp, 11));
@@ -211,10 +208,7 @@ impl<M: Media> Media for ForceChromatic<M> {
 
 fn cloud_scene() -> (Volumes<cirrus_render::GridField>, Camera, Lights) {
     let medium = common::medium(common::cloud_field(4), 12.0, 0.9, 0.5);
-    let lights = Lights {
-        sun: common::sun(0.0),
-        environment: common::env(Vec3::new(0.3, 0.4, 0.6)),
-    };
+    let lights = Lights::sun_and_sky(common::sun(0.0), common::env(Vec3::new(0.3, 0.4, 0.6)));
     let s = common::scene(medium, 24, lights);
     (s.media, s.camera, s.lights)
 }

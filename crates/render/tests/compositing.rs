@@ -65,10 +65,10 @@ fn camera() -> Camera {
 }
 
 fn lights(sun: bool, sky_on: bool) -> Lights {
-    Lights {
-        sun: sun.then(|| Sun::new(Vec3::new(-0.5, -1.0, -0.4), Vec3::new(3.0, 2.8, 2.5), 0.02)),
-        environment: sky_on.then(sky),
-    }
+    Lights::sun_and_sky(
+        sun.then(|| Sun::new(Vec3::new(-0.5, -1.0, -0.4), Vec3::new(3.0, 2.8, 2.5), 0.02)),
+        sky_on.then(sky),
+    )
 }
 
 fn settings(integrator: IntegratorKind, spp: u32) -> RenderSettings {

@@ -41,10 +41,7 @@ fn same_seed_same_image_for_any_thread_count() {
 
 #[test]
 fn time_budget_reports_the_samples_it_reached() {
-    let lights = Lights {
-        sun: common::sun(0.0),
-        environment: None,
-    };
+    let lights = Lights::sun_and_sky(common::sun(0.0), None);
     let scene = common::scene(
         common::medium(common::cloud_field(4), 8.0, 0.9, 0.5),
         8,

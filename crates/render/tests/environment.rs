@@ -28,25 +28,15 @@ fn a_constant_map_is_the_constant_environment() {
     let l = Vec3::new(0.6, 0.7, 0.9);
     let map = EnvMap::new(16, 8, vec![l; 128], 30.0);
     let medium = || common::medium(common::cloud_field(4), 8.0, 0.8, 0.3);
-    let constant = common::scene(
-        medium(),
-        16,
-        Lights {
-            sun: None,
-            environment: common::env(l),
-        },
-    );
+    let constant = common::scene(medium(), 16, Lights::sun_and_sky(None, common::env(l)));
     let mapped = common::scene(
         medium(),
         16,
-        Lights {
-            sun: None,
-            environment: Some(Environment::from_map(Arc::new(map), Vec3::ONE)),
-        },
+        Lights::sun_and_sky(None, Some(Environment::from_map(Arc::new(map), Vec3::ONE))),
     );
     let a = render(&constant, &common::settings(IntegratorKind::Path, 64, 3));
     let b = render(&mapped, &common::settings(IntegratorKind::Path, 64, 4));
-    assert!(b.stats.counters.env_samples > 0 && b.stats.counters.nee_rays_env > 0);
+    assert!(b.stats.counters.dome_samples > 0 && b.stats.counters.nee_rays_dome > 0);
     assert_agree("constant map vs constant environment", &a.image, &b.image);
     // Pixels that miss the cloud see exactly the constant.
     assert_eq!(b.image.pixel(0, 0), [l.x, l.y, l.z, 0.0]);
@@ -65,21 +55,11 @@ fn one_bright_texel_is_the_equivalent_sun() {
     // under a voxel of the 16^3 test cloud.
     let sun = Sun::new(-dir, l_texel * omega, 0.0);
     let medium = || common::medium(common::cloud_field(4), 8.0, 0.9, 0.4);
-    let with_sun = common::scene(
-        medium(),
-        16,
-        Lights {
-            sun: Some(sun),
-            environment: None,
-        },
-    );
+    let with_sun = common::scene(medium(), 16, Lights::sun_and_sky(Some(sun), None));
     let with_map = common::scene(
         medium(),
         16,
-        Lights {
-            sun: None,
-            environment: Some(Environment::from_map(Arc::new(map), Vec3::ONE)),
-        },
+        Lights::sun_and_sky(None, Some(Environment::from_map(Arc::new(map), Vec3::ONE))),
     );
     let a = render(&with_sun, &common::settings(IntegratorKind::Path, 64, 5));
     let b = render(&with_map, &common::settings(IntegratorKind::Path, 64, 6));

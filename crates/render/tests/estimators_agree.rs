@@ -9,10 +9,7 @@ use glam::Vec3;
 #[test]
 fn transmittance_estimators_and_majorant_modes_converge_to_the_same_image() {
     // A sun with a 3 degree disc (so its MIS path runs) plus a sky.
-    let lights = Lights {
-        sun: common::sun(3.0),
-        environment: common::env(Vec3::new(0.2, 0.3, 0.45)),
-    };
+    let lights = Lights::sun_and_sky(common::sun(3.0), common::env(Vec3::new(0.2, 0.3, 0.45)));
     let scene = common::scene(
         common::medium(common::cloud_field(4), 8.0, 0.9, 0.5),
         20,

@@ -27,10 +27,7 @@ fn white_furnace_is_invisible() {
         // Peak optical depth across the cloud about 5: many paths scatter
         // several times before escaping.
         let medium = common::medium(common::cloud_field(4), 8.0, 1.0, g);
-        let lights = Lights {
-            sun: None,
-            environment: common::env(Vec3::splat(l_env)),
-        };
+        let lights = Lights::sun_and_sky(None, common::env(Vec3::splat(l_env)));
         let scene = common::scene(medium, 16, lights);
         let mut settings = common::settings(IntegratorKind::Path, 64, 100 + i as u64);
         settings.transmittance = estimator;
@@ -106,14 +103,7 @@ fn a_sun_covering_the_sphere_is_a_furnace_too() {
         2.0 * std::f32::consts::PI,
     );
     let medium = common::medium(common::cloud_field(4), 8.0, 1.0, 0.5);
-    let scene = common::scene(
-        medium,
-        16,
-        Lights {
-            sun: Some(sun),
-            environment: None,
-        },
-    );
+    let scene = common::scene(medium, 16, Lights::sun_and_sky(Some(sun), None));
     let out = render(&scene, &common::settings(IntegratorKind::Path, 64, 7));
     let img = &out.image;
     let (mut diff_sum, mut var_sum) = (0f64, 0f64);

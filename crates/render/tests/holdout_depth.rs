@@ -108,10 +108,7 @@ fn setup() -> (GridField, Camera, Lights) {
     let camera = Camera::new(eye, centre, Vec3::Y, 30.0, SIZE, SIZE);
     // Sunlight travels along the view: the sun is behind the camera.
     let sun = Sun::new(camera.forward(), Vec3::splat(3.0), 0.0);
-    let lights = Lights {
-        sun: Some(sun),
-        environment: None,
-    };
+    let lights = Lights::sun_and_sky(Some(sun), None);
     (field, camera, lights)
 }
 

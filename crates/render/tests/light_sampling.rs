@@ -24,14 +24,14 @@ fn sunlit(sun_degrees: f32, sampling: LightSampling, seed: u64) -> Rendered {
 
 /// The cloud at density scale `scale` under a sun and a bright sky.
 fn lit_cloud(scale: f32, sun_degrees: f32, sampling: LightSampling, seed: u64) -> Rendered {
-    let lights = Lights {
-        sun: Some(Sun::new(
+    let lights = Lights::sun_and_sky(
+        Some(Sun::new(
             Vec3::new(-0.4, -1.0, -0.3),
             Vec3::new(1.5, 1.4, 1.2),
             sun_degrees.to_radians(),
         )),
-        environment: common::env(Vec3::new(0.5, 0.6, 0.8)),
-    };
+        common::env(Vec3::new(0.5, 0.6, 0.8)),
+    );
     let scene = common::scene(
         common::medium(common::cloud_field(4), scale, 0.95, 0.3),
         20,
@@ -66,7 +66,7 @@ fn one_light_per_vertex_agrees_with_every_light_in_a_thick_cloud() {
     let all = lit_cloud(150.0, 0.0, LightSampling::All, 41);
     let one = lit_cloud(150.0, 0.0, LightSampling::One, 42);
     let c = one.stats.counters;
-    let traced = c.nee_rays_sun + c.nee_rays_env;
+    let traced = c.nee_rays_distant + c.nee_rays_dome;
     assert!(
         (traced as f64) < 0.8 * c.real_collisions as f64,
         "{traced} shadow rays for {} vertices",
@@ -85,11 +85,11 @@ fn one_light_per_vertex_traces_at_most_one_shadow_ray_per_vertex() {
     // Every real collision scatters (unlimited depth, albedo 0.95 > 0):
     // one vertex each.
     assert!(all.real_collisions > 10_000, "{}", all.real_collisions);
-    assert_eq!(all.nee_rays_sun, all.real_collisions);
-    assert_eq!(all.nee_rays_env, all.real_collisions);
-    let traced = one.nee_rays_sun + one.nee_rays_env;
+    assert_eq!(all.nee_rays_distant, all.real_collisions);
+    assert_eq!(all.nee_rays_dome, all.real_collisions);
+    let traced = one.nee_rays_distant + one.nee_rays_dome;
     assert!(traced <= one.real_collisions, "{one:?}");
     // Both lights are picked, each with probability at least 0.1.
-    assert!(one.nee_rays_env > one.real_collisions / 10, "{one:?}");
-    assert!(one.nee_rays_sun > one.real_collisions / 10, "{one:?}");
+    assert!(one.nee_rays_dome > one.real_collisions / 10, "{one:?}");
+    assert!(one.nee_rays_distant > one.real_collisions / 10, "{one:?}");
 }

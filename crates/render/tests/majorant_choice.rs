@@ -10,10 +10,7 @@ use cirrus_render::{render, Crop, GridField, IntegratorKind, Lights, MajorantMod
 use glam::Vec3;
 
 fn lights() -> Lights {
-    Lights {
-        sun: common::sun(0.0),
-        environment: common::env(Vec3::new(0.2, 0.3, 0.45)),
-    }
+    Lights::sun_and_sky(common::sun(0.0), common::env(Vec3::new(0.2, 0.3, 0.45)))
 }
 
 /// 32^3 voxels of constant density in fine majorant cells: every cell's

@@ -117,10 +117,7 @@ fn a_rendered_pixel_sees_the_time_averaged_transmittance() {
         1,
         1,
     );
-    let lights = Lights {
-        sun: None,
-        environment: Some(Environment::new(Vec3::ONE)),
-    };
+    let lights = Lights::sun_and_sky(None, Some(Environment::new(Vec3::ONE)));
     let scene = Scene {
         media: medium,
         camera,
@@ -262,14 +259,14 @@ fn a_closed_shutter_or_no_velocity_renders_bit_identical() {
             24,
             16,
         );
-        let lights = Lights {
-            sun: Some(cirrus_render::Sun::new(
+        let lights = Lights::sun_and_sky(
+            Some(cirrus_render::Sun::new(
                 Vec3::new(0.3, -1.0, 0.2),
                 Vec3::splat(3.0),
                 0.01,
             )),
-            environment: Some(Environment::new(Vec3::new(0.2, 0.3, 0.4))),
-        };
+            Some(Environment::new(Vec3::new(0.2, 0.3, 0.4))),
+        );
         let scene = Scene {
             media: medium,
             camera,

@@ -224,10 +224,7 @@ fn white_furnace_is_invisible_with_every_phase_function() {
     for (i, phase) in phases.into_iter().enumerate() {
         let label = format!("{phase:?}");
         let medium = common::medium(common::cloud_field(4), 8.0, 1.0, 0.0).with_phase(phase);
-        let lights = Lights {
-            sun: None,
-            environment: common::env(Vec3::splat(l_env)),
-        };
+        let lights = Lights::sun_and_sky(None, common::env(Vec3::splat(l_env)));
         let scene = common::scene(medium, 12, lights);
         let mut settings = common::settings(IntegratorKind::Path, 64, 300 + i as u64);
         settings.max_depth = None;

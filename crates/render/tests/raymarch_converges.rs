@@ -28,10 +28,7 @@ fn squared_bias(a: &Image, b: &Image) -> (f64, f64) {
 fn scene() -> Scene<Volumes<GridField>> {
     // Dense enough (peak optical depth ~12) that coarse steps are visibly
     // wrong; a delta sun and a sky, so both shadow-ray kinds are exercised.
-    let lights = Lights {
-        sun: common::sun(0.0),
-        environment: common::env(Vec3::new(0.2, 0.3, 0.45)),
-    };
+    let lights = Lights::sun_and_sky(common::sun(0.0), common::env(Vec3::new(0.2, 0.3, 0.45)));
     common::scene(
         common::medium(common::cloud_field(4), 20.0, 0.9, 0.3),
         16,
@@ -93,10 +90,7 @@ fn light_grid_stores_only_bricks_near_density() {
         }
     });
     let medium = Volumes::from(common::medium(field, 10.0, 0.9, 0.0));
-    let lights = Lights {
-        sun: common::sun(0.0),
-        environment: None,
-    };
+    let lights = Lights::sun_and_sky(common::sun(0.0), None);
     let settings = LightGridSettings {
         cell_voxels: 1.0,
         env_directions: 1,

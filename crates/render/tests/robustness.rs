@@ -60,10 +60,7 @@ fn broken_scene(density: f32, majorant: f32, size: u32) -> Scene<Volumes<Broken>
         Vec3::splat(0.8),
         0.4,
     );
-    let lights = Lights {
-        sun: common::sun(1.0),
-        environment: common::env(Vec3::splat(0.3)),
-    };
+    let lights = Lights::sun_and_sky(common::sun(1.0), common::env(Vec3::splat(0.3)));
     let camera = cirrus_render::Camera::framing(medium.field.bounds(), size, size);
     Scene {
         media: medium.into(),
@@ -143,10 +140,7 @@ fn images_are_written_whole() {
     let scene = common::scene(
         common::medium(common::cloud_field(4), 8.0, 0.9, 0.5),
         12,
-        Lights {
-            sun: common::sun(0.0),
-            environment: common::env(Vec3::splat(0.2)),
-        },
+        Lights::sun_and_sky(common::sun(0.0), common::env(Vec3::splat(0.2))),
     );
     let out = render(&scene, &common::settings(IntegratorKind::Path, 2, 3));
     let dir = std::env::temp_dir().join(format!("cirrus-render-io-{}", std::process::id()));

@@ -60,10 +60,7 @@ fn sobol_beats_random_on_an_absorbing_box() {
             0.3,
         )),
         camera,
-        lights: Lights {
-            sun: None,
-            environment: common::env(Vec3::ONE),
-        },
+        lights: Lights::sun_and_sky(None, common::env(Vec3::ONE)),
     };
     let mut exact = Vec::new();
     for y in 0..size {
@@ -102,10 +99,7 @@ fn sobol_beats_random_on_an_absorbing_box() {
 /// stratification and multiple scattering dominates.)
 #[test]
 fn sobol_beats_random_on_a_scattering_cloud() {
-    let lights = Lights {
-        sun: None,
-        environment: common::env(Vec3::new(0.2, 0.3, 0.45)),
-    };
+    let lights = Lights::sun_and_sky(None, common::env(Vec3::new(0.2, 0.3, 0.45)));
     let scene = common::scene(
         common::medium(common::cloud_field(4), 8.0, 0.9, 0.5),
         16,

@@ -162,7 +162,7 @@ fn random_streams_are_the_plain_rng() {
         assert_eq!(d.get_1d(Draw::FreeFlight, 0), r.uniform());
         let (a, b) = d.get_2d(Draw::Phase, 3);
         assert_eq!((a, b), (r.uniform(), r.uniform()));
-        let led = d.leading(Draw::SunShadow, 0, |rng| rng.uniform());
+        let led = d.leading(Draw::LightShadow(0), 0, |rng| rng.uniform());
         assert_eq!(led, r.uniform());
         assert_eq!(d.rng().uniform(), r.uniform());
     }
@@ -194,8 +194,8 @@ fn draws_are_decorrelated() {
     let pairs = [
         (Draw::FreeFlight, 0, Draw::Phase, 0),
         (Draw::Phase, 0, Draw::Phase, 1),
-        (Draw::PixelJitter, 0, Draw::SunDirection, 0),
-        (Draw::SunShadow, 0, Draw::SkyShadow, 0),
+        (Draw::PixelJitter, 0, Draw::LightDirection(0), 0),
+        (Draw::LightShadow(0), 0, Draw::LightShadow(1), 0),
     ];
     for (da, va, db, vb) in pairs {
         let (mut sa, mut sb, mut sab, mut saa, mut sbb) = (0f64, 0f64, 0f64, 0f64, 0f64);

@@ -19,10 +19,10 @@ use cirrus_render::{
 use glam::Vec3;
 
 fn lights(sun_degrees: f32) -> Lights {
-    Lights {
-        sun: common::sun(sun_degrees),
-        environment: common::env(Vec3::new(0.2, 0.3, 0.45)),
-    }
+    Lights::sun_and_sky(
+        common::sun(sun_degrees),
+        common::env(Vec3::new(0.2, 0.3, 0.45)),
+    )
 }
 
 fn sunlit<F: cirrus_render::DensityField>(

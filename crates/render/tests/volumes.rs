@@ -11,10 +11,7 @@ use cirrus_render::{
 use glam::Vec3;
 
 fn lights() -> Lights {
-    Lights {
-        sun: common::sun(0.53),
-        environment: common::env(Vec3::new(0.3, 0.4, 0.6)),
-    }
+    Lights::sun_and_sky(common::sun(0.53), common::env(Vec3::new(0.3, 0.4, 0.6)))
 }
 
 /// Two half-density copies with different albedos (and majorant grids with

@@ -82,19 +82,22 @@ pub fn needed(
         return visible.to_vec();
     }
     let scattered_anywhere =
-        lights.environment.is_some() || any_emission || max_depth.is_none_or(|d| d >= 2);
+        lights.domes().next().is_some() || any_emission || max_depth.is_none_or(|d| d >= 2);
     if scattered_anywhere {
         return vec![true; n];
     }
-    let Some(sun) = &lights.sun else {
-        return visible.to_vec();
-    };
-    let to_sun = -sun.direction().as_dvec3();
-    let tan_half = sun_half_angle_tan(sun);
+    // Single scattering under distant lights: what shadows a visible
+    // volume toward any of them.
+    let prisms: Vec<(DVec3, f64)> = lights
+        .distant()
+        .map(|(_, sun)| (-sun.direction().as_dvec3(), sun_half_angle_tan(sun)))
+        .collect();
     (0..n)
         .map(|i| {
             visible[i]
-                || (0..n).any(|a| visible[a] && in_sun_prism(boxes[a], boxes[i], to_sun, tan_half))
+                || prisms.iter().any(|&(to_sun, tan_half)| {
+                    (0..n).any(|a| visible[a] && in_sun_prism(boxes[a], boxes[i], to_sun, tan_half))
+                })
         })
         .collect()
 }

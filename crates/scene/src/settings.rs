@@ -101,9 +101,5 @@ fn lights(desc: &SceneDescription) -> Result<Lights> {
             Environment::from_map(Arc::new(map), Vec3::splat(env.env_intensity()))
         }
     };
-    Ok(Lights {
-        sun,
-        environment: Some(environment),
-    }
-    .pruned())
+    Ok(Lights::sun_and_sky(sun, Some(environment)).pruned())
 }

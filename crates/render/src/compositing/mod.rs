@@ -2,7 +2,7 @@
 //! samples and ID mattes (Cryptomatte), as production renderers write them.
 //!
 //! - Light groups: every contribution an integrator adds is tagged with the
-//!   group of the light it came from ([`LightGroup`]); a [`Sample`]
+//!   group of the light it came from ([`crate::Lights::group`]); a [`Sample`]
 //!   carries the per-group radiance beside the total, and the film keeps
 //!   one mean per group. The groups are the same estimate split, so they
 //!   sum to the beauty to float rounding.
@@ -41,23 +41,9 @@ pub const MAX_LIGHT_GROUPS: usize = 8;
 /// [`Compositing::light_groups`].
 pub type GroupRadiance = [Vec3; MAX_LIGHT_GROUPS];
 
-/// The group each of the renderer's lights is tagged with: the index of
-/// its layer in [`DEFAULT_LIGHT_GROUPS`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LightGroup {
-    Sun = 0,
-    Sky = 1,
-    Emission = 2,
-}
-
-/// Layer names of the groups today's lights are tagged with, in tag order.
+/// Layer names of the default light groups: distant lights, domes and
+/// the media's emission ([`crate::Lights::new`] tags them so).
 pub const DEFAULT_LIGHT_GROUPS: [&str; 3] = ["sun", "sky", "emission"];
-
-/// Adds `value` to group `g` of `groups`.
-#[inline]
-pub(crate) fn tag(groups: &mut GroupRadiance, g: LightGroup, value: Vec3) {
-    groups[g as usize] += value;
-}
 
 /// Deep samples per pixel when none is given (the background sample
 /// comes on top).

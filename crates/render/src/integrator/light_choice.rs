@@ -6,12 +6,19 @@
 //! Cycles' light tree do: the shadow rays, the larger part of a path's
 //! tracking in a cloud lit by a sun and a sky, are halved, at the price of
 //! the noise of the pick. Without a shadow grid (below) the pick follows
-//! each light's unoccluded in-scattered radiance at the vertex, `E_sun
-//! f(w_in, w_sun)` against the sky's mean radiance (the phase function
-//! integrates to 1 over the sphere), so a forward-scattering vertex facing
-//! the sun takes the sun and one facing away takes the sky; a probability
-//! is kept within [`MIN_PROBABILITY`, 1 - `MIN_PROBABILITY`] so neither
-//! light's weight exceeds `1 / MIN_PROBABILITY`.
+//! each light's unoccluded in-scattered radiance at the vertex, `E
+//! f(w_in, w_light)` for a distant light against a dome's mean radiance
+//! (the phase function integrates to 1 over the sphere), so a
+//! forward-scattering vertex facing the sun takes the sun and one facing
+//! away takes the sky; every light keeps a defensive share of at least
+//! `min(MIN_PROBABILITY, 1 / 2n)` of the `n` lights (with two, a
+//! probability within [`MIN_PROBABILITY`, 1 - `MIN_PROBABILITY`]), so no
+//! light is starved where the weights are wrong.
+//!
+//! The probabilities are laid end to end around the unit interval and one
+//! number picks ([`LightChoice::picks`]): each light is sampled with its
+//! probability, none where they sum below one, two where a disc's floor
+//! (below) lifts them past one.
 //!
 //! Through the media: inside a thick cloud nine in ten shadow rays bring
 //! nothing back (measured on the thick benchmark cloud: the sun's and the
@@ -39,10 +46,9 @@
 
 use glam::Vec3;
 
-use super::light_grid::Seen;
-use crate::light::Lights;
+use crate::light::{Light, Lights};
 use crate::phase::Phase;
-use crate::spectrum::luminance;
+use crate::sampling::UNIFORM_SPHERE_PDF;
 
 settings_enum! {
     /// How many lights next-event estimation samples at each vertex.
@@ -63,13 +69,19 @@ impl LightSampling {
     /// Whether a vertex picks one light under `lights` (pruned of the dark
     /// ones): `one`, resolved, with a sun or a sky to pick.
     pub fn picks_one(self, lights: &Lights) -> bool {
-        self.resolve(lights) == Self::One && (lights.sun.is_some() || lights.environment.is_some())
+        self.resolve(lights) == Self::One && !lights.is_empty()
     }
 
-    /// What `self` comes to under `lights`: `All` or `One`.
+    /// What `self` comes to under `lights`: `All` or `One` (`All` past
+    /// [`MAX_PICKED_LIGHTS`] lights).
     pub fn resolve(self, lights: &Lights) -> LightSampling {
         match self {
-            Self::Auto if lights.environment.as_ref().is_some_and(|e| e.map.is_none()) => Self::One,
+            _ if lights.len() > MAX_PICKED_LIGHTS => Self::All,
+            Self::Auto
+                if lights.domes().next().is_some() && lights.domes().all(|e| e.map.is_none()) =>
+            {
+                Self::One
+            }
             Self::Auto => Self::All,
             other => other,
         }
@@ -118,126 +130,289 @@ pub fn disc_floor(f: f32, solid_angle: f32) -> f32 {
     }
 }
 
-/// The probability that a vertex's next-event estimation samples each
-/// light (1 for both under `all`: each light is sampled once).
+/// The most lights a vertex picks among; a scene with more samples every
+/// light ([`LightSampling::resolve`]).
+///
+/// The pick is computed at every vertex and carried to the next one for
+/// the escaped ray's weight, so its probabilities are a plain array on the
+/// stack: a growable one (with its spill checks and drops) cost the thick
+/// benchmark cloud a sixth of its render time. Many lights want a sampler
+/// that does not weigh each of them at every vertex (a light tree) rather
+/// than a longer array.
+pub const MAX_PICKED_LIGHTS: usize = 8;
+
+/// One value per light, in the order of [`Lights`] (at most
+/// [`MAX_PICKED_LIGHTS`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct LightChoice {
-    pub sun: f32,
-    pub sky: f32,
+pub(crate) struct PerLight {
+    values: [f32; MAX_PICKED_LIGHTS],
+    len: usize,
+}
+
+impl PerLight {
+    /// `n` zeros (`n` at most [`MAX_PICKED_LIGHTS`]).
+    #[inline]
+    pub fn zeros(n: usize) -> Self {
+        debug_assert!(n <= MAX_PICKED_LIGHTS);
+        Self {
+            values: [0.0; MAX_PICKED_LIGHTS],
+            len: n.min(MAX_PICKED_LIGHTS),
+        }
+    }
+}
+
+impl std::ops::Deref for PerLight {
+    type Target = [f32];
+    #[inline]
+    fn deref(&self) -> &[f32] {
+        &self.values[..self.len]
+    }
+}
+
+impl std::ops::DerefMut for PerLight {
+    #[inline]
+    fn deref_mut(&mut self) -> &mut [f32] {
+        &mut self.values[..self.len]
+    }
+}
+
+/// The probability that a vertex's next-event estimation samples each
+/// light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum LightChoice {
+    /// Every light, once (probability 1 each; no number drawn).
+    All,
+    /// Each light with its probability. They may sum to less than one
+    /// (the vertex then samples no light with the rest) or, where a disc's
+    /// floor raised one, to more (it then sometimes samples two).
+    Pick(PerLight),
 }
 
 impl LightChoice {
-    /// Every light sampled.
-    pub const ALL: LightChoice = LightChoice { sun: 1.0, sky: 1.0 };
-
     /// The pick at a vertex reached along `dir_in` with phase function
-    /// `phase`: [`Self::ALL`] unless `sampling` is `one` (resolved, see
-    /// [`LightSampling::resolve`]) and both a sun and a sky light the scene.
+    /// `phase`, each light weighed by its unoccluded in-scattered light:
+    /// [`Self::All`] unless `sampling` is `one` (resolved, see
+    /// [`LightSampling::resolve`]) and there are lights to choose among.
     pub fn at(sampling: LightSampling, lights: &Lights, phase: &Phase, dir_in: Vec3) -> Self {
-        match &lights.sun {
-            Some(sun) => Self::facing_sun(sampling, lights, phase.eval(dir_in, -sun.direction())),
-            None => Self::ALL,
+        if sampling != LightSampling::One || lights.len() < 2 {
+            return Self::All;
         }
+        let mut p = PerLight::zeros(lights.len());
+        let mut floors = p;
+        for (i, (p, floor)) in p.iter_mut().zip(floors.iter_mut()).enumerate() {
+            (*p, *floor) = weigh(lights, i, phase, dir_in);
+        }
+        into_shares(&mut p);
+        raise_to_floors(&mut p, &floors);
+        Self::Pick(p)
     }
 
-    /// The pick at a vertex whose phase function toward the sun's centre
-    /// is `f_sun`.
-    pub fn facing_sun(sampling: LightSampling, lights: &Lights, f_sun: f32) -> Self {
-        let (Some(sun), Some(env), LightSampling::One) =
-            (&lights.sun, &lights.environment, sampling)
-        else {
-            return Self::ALL;
-        };
-        let sun_light = luminance(sun.irradiance()) * f_sun;
-        let sky_light = luminance(env.mean_radiance());
-        let p = sun_light / (sun_light + sky_light);
-        let p = if p.is_finite() { p } else { 0.5 };
-        let p = p.clamp(MIN_PROBABILITY, 1.0 - MIN_PROBABILITY);
-        LightChoice {
-            sun: p,
-            sky: 1.0 - p,
+    /// The probability that a vertex whose phase function toward distant
+    /// light `light`'s centre is `f` samples that light, unoccluded, the
+    /// others weighed as from an isotropic vertex (an estimate, for
+    /// sunward scattering's keep probability, which only needs to be the
+    /// same for both of its strategies).
+    pub fn facing(sampling: LightSampling, lights: &Lights, light: usize, f: f32) -> f32 {
+        if sampling != LightSampling::One || lights.len() < 2 {
+            return 1.0;
         }
-        .with_disc_floor(lights, f_sun)
+        let weight = |i: usize| {
+            lights.luminance(i)
+                * match lights.get(i) {
+                    Light::Distant(_) if i == light => f,
+                    Light::Distant(_) => UNIFORM_SPHERE_PDF,
+                    Light::Dome(_) => 1.0,
+                }
+        };
+        let share = Shares::of((0..lights.len()).map(weight)).share(weight(light));
+        let floor = match lights.get(light) {
+            Light::Distant(sun) => disc_floor(f, sun.solid_angle()),
+            Light::Dome(_) => 0.0,
+        };
+        share.max(floor)
     }
 
     /// The pick at a vertex reached along `dir_in` with phase function
-    /// `phase` (`one`: a sun, a sky or both), which sees the fractions
-    /// `seen` of each light's in-scattered radiance through the media (a
-    /// shadow grid's estimate); and no light at all, with the remaining
-    /// probability, where it sees less than [`TRACE_FRACTION`] of the
-    /// unoccluded light.
-    pub fn shadowed(lights: &Lights, seen: Seen, phase: &Phase, dir_in: Vec3) -> Self {
-        let f_sun = lights
-            .sun
-            .as_ref()
-            .map_or(0.0, |sun| phase.eval(dir_in, -sun.direction()));
-        let sun_open = lights
-            .sun
-            .as_ref()
-            .map_or(0.0, |sun| luminance(sun.irradiance()) * f_sun);
-        let sky_open = lights
-            .environment
-            .as_ref()
-            .map_or(0.0, |env| luminance(env.mean_radiance()));
-        let (sun_seen, sky_seen) = (sun_open * seen.sun, sky_open * seen.sky);
-        let trace = (sun_seen + sky_seen) / (TRACE_FRACTION * (sun_open + sky_open));
+    /// `phase` (`one`), which sees the fractions `seen` of each light's
+    /// in-scattered light through the media (a shadow grid's estimate):
+    /// the lights weighed by what they bring through the media, and no
+    /// light at all, with the remaining probability, where the vertex sees
+    /// less than [`TRACE_FRACTION`] of its unoccluded light.
+    pub fn shadowed(lights: &Lights, seen: &[f32], phase: &Phase, dir_in: Vec3) -> Self {
+        // Each light's unoccluded light, then (in place) what it brings
+        // through the media.
+        let mut p = PerLight::zeros(lights.len());
+        let mut floors = p;
+        let (mut open_total, mut seen_total) = (0.0f32, 0.0f32);
+        for (i, ((&seen, p), floor)) in seen
+            .iter()
+            .zip(p.iter_mut())
+            .zip(floors.iter_mut())
+            .enumerate()
+        {
+            let open;
+            (open, *floor) = weigh(lights, i, phase, dir_in);
+            open_total += open;
+            seen_total += open * seen;
+            *p = open;
+        }
+        let trace = seen_total / (TRACE_FRACTION * open_total);
         let trace = if trace.is_finite() {
             trace.clamp(MIN_TRACE, 1.0)
         } else {
             1.0
         };
-        let p_sun = match (&lights.sun, &lights.environment) {
-            (Some(_), Some(_)) => {
-                let p_sun = if sun_seen + sky_seen > 0.0 {
-                    sun_seen / (sun_seen + sky_seen)
-                } else {
-                    sun_open / (sun_open + sky_open)
-                };
-                let p_sun = if p_sun.is_finite() { p_sun } else { 0.5 };
-                p_sun.clamp(MIN_PROBABILITY, 1.0 - MIN_PROBABILITY)
+        // Where the grid sees no light at all, the unoccluded weights.
+        let total = if seen_total > 0.0 {
+            for (p, &seen) in p.iter_mut().zip(seen) {
+                *p *= seen;
             }
-            (Some(_), None) => 1.0,
-            _ => 0.0,
+            seen_total
+        } else {
+            open_total
         };
-        LightChoice {
-            sun: trace * p_sun,
-            sky: trace * (1.0 - p_sun),
+        let shares = Shares::with_total(p.iter().copied(), p.len() as u32, total);
+        for (p, &floor) in p.iter_mut().zip(floors.iter()) {
+            *p = (trace * shares.share(*p)).max(floor);
         }
-        .with_disc_floor(lights, f_sun)
+        Self::Pick(p)
     }
 
-    /// The pick with the sun's probability raised to
-    /// [`disc_floor`] where its disc would otherwise be left to phase
-    /// sampling (the sky's probability unchanged: where the two then sum
-    /// past one, a vertex sometimes samples both).
-    fn with_disc_floor(self, lights: &Lights, f_sun: f32) -> Self {
-        let floor = lights
-            .sun
-            .as_ref()
-            .map_or(0.0, |sun| disc_floor(f_sun, sun.solid_angle()));
-        LightChoice {
-            sun: self.sun.max(floor),
-            ..self
+    /// The probability that light `i` is sampled.
+    #[inline]
+    pub fn probability(&self, i: usize) -> f32 {
+        match self {
+            Self::All => 1.0,
+            Self::Pick(p) => p[i],
         }
     }
 
-    /// Which lights a vertex samples, from one uniform number `u`: the sun
-    /// below `sun`, the sky over the next `sky` of the unit interval,
-    /// wrapping around to its start where the two sum past one (so each
-    /// is sampled with exactly its probability, and never both while they
-    /// sum to one or less).
+    /// Whether `u` (uniform in [0, 1)) samples light `i`: the lights'
+    /// probabilities laid end to end around the unit interval, in list
+    /// order, wrapping to its start past one. Each light is sampled with
+    /// exactly its probability, and two only where the probabilities sum
+    /// past one.
     #[inline]
-    pub fn picks(self, u: f32) -> (bool, bool) {
-        let sun = u < self.sun;
-        let end = self.sun + self.sky;
-        let sky = (u >= self.sun && u < end) || u < end - 1.0;
-        (sun, sky)
+    pub fn picks(p: &[f32], u: f32) -> impl Iterator<Item = usize> + '_ {
+        let mut start = 0.0f32;
+        p.iter().enumerate().filter_map(move |(i, &pi)| {
+            let (s, e) = (start, start + pi);
+            start = if e >= 1.0 { e - 1.0 } else { e };
+            ((u >= s && u < e) || u < e - 1.0).then_some(i)
+        })
+    }
+}
+
+/// A light's unoccluded in-scattered luminance at a vertex reached along
+/// `dir_in` (`f E` toward a distant light's centre, a dome's mean radiance:
+/// the phase function integrates to 1 over the sphere), and the least
+/// probability its disc needs ([`disc_floor`]; 0 for other lights).
+#[inline(always)]
+fn weigh(lights: &Lights, i: usize, phase: &Phase, dir_in: Vec3) -> (f32, f32) {
+    match lights.get(i) {
+        Light::Distant(sun) => {
+            let f = phase.eval(dir_in, -sun.direction());
+            let floor = if sun.is_delta() {
+                0.0
+            } else {
+                disc_floor(f, sun.solid_angle())
+            };
+            (lights.luminance(i) * f, floor)
+        }
+        Light::Dome(_) => (lights.luminance(i), 0.0),
+    }
+}
+
+/// Weights' shares of their sum, every share at least the defensive floor
+/// `min(MIN_PROBABILITY, 1 / (2 n))` (those above it scaled down to make
+/// room), so that no light is starved where the weights are wrong; equal
+/// shares where the weights sum to nothing or overflow.
+#[derive(Clone, Copy, Debug)]
+struct Shares {
+    total: f32,
+    floor: f32,
+    /// What a share above the floor is multiplied by (exactly 1 where no
+    /// share is below it).
+    scale: f32,
+    /// `Some(1 / n)` where the weights say nothing.
+    equal: Option<f32>,
+}
+
+impl Shares {
+    #[inline]
+    fn of(weights: impl Iterator<Item = f32> + Clone) -> Self {
+        let (n, total) = weights
+            .clone()
+            .fold((0u32, 0.0f32), |(n, t), w| (n + 1, t + w));
+        Self::with_total(weights, n, total)
     }
 
-    /// Whether this samples every light (no pick to draw).
+    /// [`Self::of`] `n` weights known to sum to `total`.
     #[inline]
-    pub fn is_all(self) -> bool {
-        self == Self::ALL
+    fn with_total(weights: impl Iterator<Item = f32>, n: u32, total: f32) -> Self {
+        let floor = if n < 2 {
+            0.0
+        } else {
+            MIN_PROBABILITY.min(0.5 / n as f32)
+        };
+        let mut shares = Self {
+            total,
+            floor,
+            scale: 1.0,
+            equal: None,
+        };
+        if !(total > 0.0 && total.is_finite()) {
+            shares.equal = Some(1.0 / n as f32);
+            return shares;
+        }
+        let (mut low, mut high) = (0u32, 0.0f32);
+        for w in weights {
+            let p = w / total;
+            if p < floor {
+                low += 1;
+            } else {
+                high += p;
+            }
+        }
+        if low > 0 {
+            shares.scale = (1.0 - floor * low as f32) / high;
+        }
+        shares
+    }
+
+    /// The share of weight `w`, one of those the shares were made of.
+    #[inline]
+    fn share(self, w: f32) -> f32 {
+        if let Some(equal) = self.equal {
+            return equal;
+        }
+        let p = w / self.total;
+        if p < self.floor {
+            self.floor
+        } else if self.scale == 1.0 {
+            p
+        } else {
+            p * self.scale
+        }
+    }
+}
+
+/// Turns weights into their [`Shares`].
+#[inline]
+fn into_shares(p: &mut [f32]) {
+    let shares = Shares::of(p.iter().copied());
+    for p in p.iter_mut() {
+        *p = shares.share(*p);
+    }
+}
+
+/// Raises each probability to its light's disc floor (the others
+/// unchanged: where they then sum past one, a vertex sometimes samples
+/// two).
+#[inline]
+fn raise_to_floors(p: &mut [f32], floors: &[f32]) {
+    for (p, &floor) in p.iter_mut().zip(floors) {
+        *p = p.max(floor);
     }
 }
 
@@ -249,11 +424,20 @@ mod tests {
     use super::super::light_grid::LightGrid;
     use crate::env_map::EnvMap;
     use crate::light::{Environment, Sun};
+    use crate::spectrum::luminance;
 
     fn lights() -> Lights {
-        Lights {
-            sun: Some(Sun::new(Vec3::new(0.0, -1.0, 0.0), Vec3::splat(3.0), 0.0)),
-            environment: Some(Environment::new(Vec3::splat(0.2))),
+        Lights::sun_and_sky(
+            Some(Sun::new(Vec3::new(0.0, -1.0, 0.0), Vec3::splat(3.0), 0.0)),
+            Some(Environment::new(Vec3::splat(0.2))),
+        )
+    }
+
+    /// The probabilities of a pick (panics for `All`).
+    fn probabilities(c: &LightChoice) -> &[f32] {
+        match c {
+            LightChoice::Pick(p) => p,
+            LightChoice::All => panic!("every light sampled"),
         }
     }
 
@@ -275,13 +459,53 @@ mod tests {
             (Vec3::new(0.3, 0.5, -0.2).normalize(), "oblique"),
         ] {
             let c = LightChoice::at(LightSampling::One, &l, &phase, dir_in);
-            assert!((c.sun - expected(dir_in)).abs() < 1e-6, "{label}: {c:?}");
-            assert!((c.sun + c.sky - 1.0).abs() < 1e-6, "{label}: {c:?}");
+            let p = probabilities(&c);
+            assert!((p[0] - expected(dir_in)).abs() < 1e-6, "{label}: {c:?}");
+            assert!((p[0] + p[1] - 1.0).abs() < 1e-6, "{label}: {c:?}");
+            let facing =
+                LightChoice::facing(LightSampling::One, &l, 0, phase.eval(dir_in, Vec3::Y));
+            assert!(
+                (facing - p[0]).abs() < 1e-6,
+                "{label}: {facing} against {c:?}"
+            );
         }
         let away = LightChoice::at(LightSampling::One, &l, &phase, Vec3::NEG_Y);
         let toward = LightChoice::at(LightSampling::One, &l, &phase, Vec3::Y);
-        assert!(away.sun < 0.1, "{away:?}");
-        assert_eq!(toward.sun, 1.0 - MIN_PROBABILITY);
+        assert!(probabilities(&away)[0] < 0.1, "{away:?}");
+        assert!((probabilities(&toward)[0] - (1.0 - MIN_PROBABILITY)).abs() < 1e-6);
+    }
+
+    /// Shares sum to one, follow the weights where every share is above
+    /// the floor, and lift every light to the floor otherwise, for any
+    /// number of lights; equal where the weights say nothing.
+    #[test]
+    fn shares_keep_every_light_at_its_floor() {
+        let cases: [&[f32]; 6] = [
+            &[1.0, 3.0],
+            &[1e-4, 1.0],
+            &[0.0, 2.0, 5.0],
+            &[1.0; 10],
+            &[0.0, 0.0],
+            &[f32::INFINITY, 1.0],
+        ];
+        for w in cases {
+            let mut p = w.to_vec();
+            into_shares(&mut p);
+            let n = w.len() as f32;
+            let floor = MIN_PROBABILITY.min(0.5 / n);
+            assert!((p.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{w:?}: {p:?}");
+            assert!(p.iter().all(|&p| p >= floor - 1e-7), "{w:?}: {p:?}");
+        }
+        let shares = |w: &[f32]| {
+            let mut p = w.to_vec();
+            into_shares(&mut p);
+            p
+        };
+        assert_eq!(shares(&[1.0, 3.0]), [0.25, 0.75]);
+        let p = shares(&[0.0, 2.0, 6.0]);
+        assert_eq!(p[0], MIN_PROBABILITY);
+        assert!((p[2] / p[1] - 3.0).abs() < 1e-5, "{p:?}");
+        assert_eq!(shares(&[0.0, 0.0]), [0.5, 0.5]);
     }
 
     /// With the floor, a phase-sampled ray escaping into the sun's disc
@@ -309,42 +533,39 @@ mod tests {
     }
 
     /// One uniform number picks each light with exactly its probability,
-    /// and both only where the probabilities sum past one.
+    /// and two only as often as the probabilities sum past one.
     #[test]
     fn a_pick_samples_each_light_with_its_probability() {
-        for (sun, sky) in [
-            (0.3f32, 0.5f32),
-            (0.05, 0.0025),
-            (0.8, 0.6),
-            (1.0, 0.2),
-            (0.0, 0.7),
-        ] {
-            let choice = LightChoice { sun, sky };
+        let cases: [&[f32]; 7] = [
+            &[0.3, 0.5],
+            &[0.05, 0.0025],
+            &[0.8, 0.6],
+            &[1.0, 0.2],
+            &[0.0, 0.7],
+            &[0.2, 0.3, 0.4],
+            &[0.9, 0.5, 0.7],
+        ];
+        for p in cases {
             let n = 100_000;
-            let (mut suns, mut skies, mut both) = (0, 0, 0);
+            let mut counts = vec![0u32; p.len()];
+            let mut samples = 0u32;
             for i in 0..n {
-                let (a, b) = choice.picks((i as f32 + 0.5) / n as f32);
-                suns += u32::from(a);
-                skies += u32::from(b);
-                both += u32::from(a && b);
+                for light in LightChoice::picks(p, (i as f32 + 0.5) / n as f32) {
+                    counts[light] += 1;
+                    samples += 1;
+                }
             }
-            let frac = |k: u32| k as f32 / n as f32;
-            assert!(
-                (frac(suns) - sun).abs() < 1e-4,
-                "{choice:?}: sun {}",
-                frac(suns)
-            );
-            assert!(
-                (frac(skies) - sky).abs() < 1e-4,
-                "{choice:?}: sky {}",
-                frac(skies)
-            );
-            let overlap = (sun + sky - 1.0).max(0.0);
-            assert!(
-                (frac(both) - overlap).abs() < 1e-4,
-                "{choice:?}: both {}",
-                frac(both)
-            );
+            for (light, &k) in counts.iter().enumerate() {
+                let frac = k as f32 / n as f32;
+                assert!(
+                    (frac - p[light]).abs() < 1e-4,
+                    "{p:?}: light {light} {frac}"
+                );
+            }
+            // A pick never samples one light twice, so the samples per
+            // vertex average the probabilities' sum.
+            let total: f32 = p.iter().sum();
+            assert!((samples as f32 / n as f32 - total).abs() < 1e-4, "{p:?}");
         }
     }
 
@@ -352,20 +573,22 @@ mod tests {
     fn all_or_a_single_light_samples_every_light() {
         let phase = Phase::hg(0.3);
         let l = lights();
-        assert!(LightChoice::at(LightSampling::All, &l, &phase, Vec3::X).is_all());
+        assert_eq!(
+            LightChoice::at(LightSampling::All, &l, &phase, Vec3::X),
+            LightChoice::All
+        );
         assert_eq!(LightSampling::Auto.resolve(&l), LightSampling::One);
         let map = Arc::new(EnvMap::new(2, 1, vec![Vec3::ONE, Vec3::splat(4.0)], 0.0));
-        let mapped = Lights {
-            environment: Some(Environment::from_map(map, Vec3::ONE)),
-            ..l.clone()
-        };
+        let sun = Sun::new(Vec3::new(0.0, -1.0, 0.0), Vec3::splat(3.0), 0.0);
+        let mapped = Lights::sun_and_sky(Some(sun), Some(Environment::from_map(map, Vec3::ONE)));
         assert_eq!(LightSampling::Auto.resolve(&mapped), LightSampling::All);
         assert_eq!(LightSampling::One.resolve(&mapped), LightSampling::One);
-        let sun_only = Lights {
-            environment: None,
-            ..l.clone()
-        };
-        assert!(LightChoice::at(LightSampling::One, &sun_only, &phase, Vec3::X).is_all());
+        let sun_only = Lights::sun_and_sky(Some(sun), None);
+        assert_eq!(LightSampling::Auto.resolve(&sun_only), LightSampling::All);
+        assert_eq!(
+            LightChoice::at(LightSampling::One, &sun_only, &phase, Vec3::X),
+            LightChoice::All
+        );
     }
 
     /// A cube of uniform density 4 over [0, 4]^3 (optical depth 16 across),
@@ -387,41 +610,33 @@ mod tests {
         let grid = cube_grid(&l);
         let phase = Phase::hg(0.5);
         let dir_in = Vec3::new(0.3, 0.5, -0.2).normalize();
-        let deep = LightChoice::shadowed(
-            &l,
-            grid.seen(&phase, Vec3::splat(2.0), dir_in),
-            &phase,
-            dir_in,
-        );
-        assert!((deep.sun + deep.sky - MIN_TRACE).abs() < 1e-6, "{deep:?}");
-        assert!(deep.sun >= MIN_PROBABILITY * MIN_TRACE && deep.sky >= MIN_PROBABILITY * MIN_TRACE);
+        let shadowed = |l: &Lights, grid: &LightGrid, p: Vec3| {
+            let c = LightChoice::shadowed(l, &grid.seen(&phase, p, dir_in), &phase, dir_in);
+            probabilities(&c).to_vec()
+        };
+        let deep = shadowed(&l, &grid, Vec3::splat(2.0));
+        assert!((deep[0] + deep[1] - MIN_TRACE).abs() < 1e-6, "{deep:?}");
+        assert!(deep
+            .iter()
+            .all(|&p| p >= MIN_PROBABILITY * MIN_TRACE * 0.999));
         // The sun shines down (+y is toward it): 0.05 below the top face.
         let top = Vec3::new(2.0, 3.95, 2.0);
-        let lit = LightChoice::shadowed(&l, grid.seen(&phase, top, dir_in), &phase, dir_in);
-        assert!((lit.sun + lit.sky - 1.0).abs() < 1e-6, "{lit:?}");
+        let lit = shadowed(&l, &grid, top);
+        assert!((lit[0] + lit[1] - 1.0).abs() < 1e-6, "{lit:?}");
         let seen = grid.in_scatter(&phase, &l, top, dir_in);
-        let share = luminance(seen.sun) / (luminance(seen.sun) + luminance(seen.sky));
-        let share = share.clamp(MIN_PROBABILITY, 1.0 - MIN_PROBABILITY);
-        assert!((lit.sun - share).abs() < 1e-5, "{lit:?} against {share}");
+        let (sun, sky) = (luminance(seen.group(0)), luminance(seen.group(1)));
+        let share = (sun / (sun + sky)).clamp(MIN_PROBABILITY, 1.0 - MIN_PROBABILITY);
+        assert!((lit[0] - share).abs() < 1e-5, "{lit:?} against {share}");
         // The unoccluded pick does not see the cube, so it weighs the two
         // lights otherwise.
         let open = LightChoice::at(LightSampling::One, &l, &phase, dir_in);
-        assert!(lit.sun != open.sun, "{lit:?} {open:?}");
-        let sky_only = Lights {
-            sun: None,
-            ..l.clone()
-        };
+        assert!(lit[0] != probabilities(&open)[0], "{lit:?} {open:?}");
+        let sky_only = Lights::sun_and_sky(None, Some(Environment::new(Vec3::splat(0.2))));
         let grid = cube_grid(&sky_only);
-        let deep = LightChoice::shadowed(
-            &sky_only,
-            grid.seen(&phase, Vec3::splat(2.0), dir_in),
-            &phase,
-            dir_in,
-        );
-        assert_eq!(deep.sun, 0.0);
-        assert!((deep.sky - MIN_TRACE).abs() < 1e-6, "{deep:?}");
-        let edge = LightChoice::shadowed(&sky_only, grid.seen(&phase, top, dir_in), &phase, dir_in);
-        assert_eq!(edge.sun, 0.0);
-        assert!(edge.sky > 10.0 * MIN_TRACE && edge.sky <= 1.0, "{edge:?}");
+        let deep = shadowed(&sky_only, &grid, Vec3::splat(2.0));
+        assert_eq!(deep.len(), 1);
+        assert!((deep[0] - MIN_TRACE).abs() < 1e-6, "{deep:?}");
+        let edge = shadowed(&sky_only, &grid, top);
+        assert!(edge[0] > 10.0 * MIN_TRACE && edge[0] <= 1.0, "{edge:?}");
     }
 }

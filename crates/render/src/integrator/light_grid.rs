@@ -1,11 +1,14 @@
 //! Pass one of Kajiya and Von Herzen (1984): the direct light at every point
 //! of a lattice over the field, stored sparsely in bricks.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4, Vec4Swizzles};
 use rayon::prelude::*;
 
 use super::march::{marched_transmittance, ShadowEnd, MIN_STEP_VOXELS};
-use crate::light::Lights;
+use smallvec::SmallVec;
+
+use super::light_choice::PerLight;
+use crate::light::{Light, LightKind, Lights};
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::sampling::{from_local, Rng};
@@ -29,15 +32,6 @@ const CHOICE_MAX_POINTS: f32 = 64.0;
 /// alone.
 const CHOICE_SEED: u64 = 0x5348_4144_4f57_5321;
 
-/// The fractions of the sun's and of the sky's unoccluded in-scattered
-/// radiance that reach a point through the media, as a [`LightGrid`]
-/// estimates them ([`LightGrid::seen`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Seen {
-    pub sun: f32,
-    pub sky: f32,
-}
-
 /// Resolution and quality of the two-pass light grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightGridSettings {
@@ -56,9 +50,13 @@ impl Default for LightGridSettings {
     }
 }
 
-/// What is stored per lattice point: the sun's transmittance, and the first
-/// two spherical-harmonic bands of the environment's transmittance
-/// `T(p, w)`, as `a = mean of T` and `b = mean of T w` over the sphere.
+/// What is stored per lattice point: one four-value slot per light, in
+/// the lights' order. A distant light's slot holds its transmittance
+/// toward its centre (the rest zero); a dome's the first two
+/// spherical-harmonic bands of its transmittance `T(p, w)`, as `a = mean
+/// of T` and `b = mean of T w` over the sphere. (Four values for a
+/// distant light too, so that every slot is one vector interpolated in
+/// one go: the lookup is on every vertex's path.)
 ///
 /// Kajiya and Von Herzen expanded the light field in spherical harmonics;
 /// bands 0 and 1 are enough here because by Funk-Hecke a phase function's
@@ -66,7 +64,7 @@ impl Default for LightGridSettings {
 /// coefficients are `g^l`), so the in-scattered environment light toward a
 /// ray travelling along `d` is `L_env * (a + 3 <mu> b . d)`: exact for an
 /// isotropic phase function, missing only band 2 and higher otherwise.
-type Entry = [f32; 4 + 1];
+type Entry = SmallVec<[Vec4; 4]>;
 
 /// Sparse lattice of direct light over the field's bounds.
 ///
@@ -79,8 +77,13 @@ pub struct LightGrid {
     cell: f32,
     points: [usize; 3],
     bricks: [usize; 3],
-    /// Per brick, its 8^3 entries (x fastest), or `None` where empty.
-    brick_data: Vec<Option<Box<[Entry]>>>,
+    /// The kinds of the lights the grid was built for, in order.
+    kinds: Vec<LightKind>,
+    /// Slots per lattice point: one per light.
+    width: usize,
+    /// Per brick, its 8^3 entries (x fastest) of `width` slots each, or
+    /// `None` where empty.
+    brick_data: Vec<Option<Box<[Vec4]>>>,
 }
 
 impl LightGrid {
@@ -105,23 +108,27 @@ impl LightGrid {
         let extent = bounds.size().max(Vec3::ZERO);
         let points = [0, 1, 2].map(|a| (extent[a] / cell).ceil() as usize + 1);
         let bricks = points.map(|n| n.div_ceil(BRICK));
+        let kinds: Vec<LightKind> = lights.iter().map(Light::kind).collect();
+        let width = kinds.len();
         let mut grid = Self {
             lo,
             cell,
             points,
             bricks,
+            kinds,
+            width,
             brick_data: Vec::new(),
         };
         let n_bricks = bricks.iter().product::<usize>();
         let env_dirs = settings.env_directions.max(1);
-        let built: Vec<(Option<Box<[Entry]>>, Counters)> = (0..n_bricks)
+        let built: Vec<(Option<Box<[Vec4]>>, Counters)> = (0..n_bricks)
             .into_par_iter()
             .map(|b| {
                 let mut bc = Counters::default();
                 let origin = grid.brick_origin(b);
                 let data = grid.brick_occupied(medium, origin, &mut bc).then(|| {
-                    let mut out = vec![[0.0; 5]; BRICK_POINTS];
-                    for (local, entry) in out.iter_mut().enumerate() {
+                    let mut out = vec![Vec4::ZERO; BRICK_POINTS * width];
+                    for (local, entry) in out.chunks_exact_mut(width.max(1)).enumerate() {
                         let ijk = [
                             local % BRICK,
                             (local / BRICK) % BRICK,
@@ -133,8 +140,7 @@ impl LightGrid {
                         }
                         let index = q[0] + points[0] * (q[1] + points[1] * q[2]);
                         let mut rng = Rng::new(seed ^ GRID_DOMAIN, index as u64, 0);
-                        *entry =
-                            grid.light_at(medium, &lights, q, step, env_dirs, &mut rng, &mut bc);
+                        grid.light_at(medium, &lights, q, step, env_dirs, &mut rng, &mut bc, entry);
                     }
                     out.into_boxed_slice()
                 });
@@ -184,7 +190,7 @@ impl LightGrid {
     }
 
     /// Number of bricks holding light (for reporting sparsity); each
-    /// costs 8^3 entries of 20 bytes.
+    /// costs 8^3 entries of 4 bytes per value (20 for a sun and a sky).
     pub fn stored_bricks(&self) -> usize {
         self.brick_data.iter().filter(|b| b.is_some()).count()
     }
@@ -219,6 +225,7 @@ impl LightGrid {
         false
     }
 
+    /// Fills `entry` with what lattice point `q` sees of each light.
     #[allow(clippy::too_many_arguments)]
     fn light_at<M: Media>(
         &self,
@@ -229,47 +236,58 @@ impl LightGrid {
         env_dirs: u32,
         rng: &mut Rng,
         c: &mut Counters,
-    ) -> Entry {
+        entry: &mut [Vec4],
+    ) {
         let p = self.lo + self.cell * Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32);
-        let mut e = [0.0; 5];
-        if let Some(sun) = &lights.sun {
-            e[0] = marched_transmittance::<M, f32>(
-                medium,
-                p,
-                -sun.direction(),
-                step,
-                ShadowEnd::Cutoff,
-                rng,
-                c,
-            );
-        }
-        if lights.environment.is_some() {
-            // Directions stratified in cos(theta), random in phi.
-            let (mut a, mut b) = (0.0, Vec3::ZERO);
-            for s in 0..env_dirs {
-                let z = 1.0 - 2.0 * (s as f32 + rng.uniform()) / env_dirs as f32;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let phi = std::f32::consts::TAU * rng.uniform();
-                let w = from_local(Vec3::Z, r * phi.cos(), r * phi.sin(), z);
-                let tr =
-                    marched_transmittance::<M, f32>(medium, p, w, step, ShadowEnd::Cutoff, rng, c);
-                a += tr;
-                b += tr * w;
+        for (slot, light) in entry.iter_mut().zip(lights.iter()) {
+            match light {
+                Light::Distant(sun) => {
+                    slot.x = marched_transmittance::<M, f32>(
+                        medium,
+                        p,
+                        -sun.direction(),
+                        step,
+                        ShadowEnd::Cutoff,
+                        rng,
+                        c,
+                    );
+                }
+                Light::Dome(_) => {
+                    // Directions stratified in cos(theta), random in phi.
+                    let (mut a, mut b) = (0.0, Vec3::ZERO);
+                    for s in 0..env_dirs {
+                        let z = 1.0 - 2.0 * (s as f32 + rng.uniform()) / env_dirs as f32;
+                        let r = (1.0 - z * z).max(0.0).sqrt();
+                        let phi = std::f32::consts::TAU * rng.uniform();
+                        let w = from_local(Vec3::Z, r * phi.cos(), r * phi.sin(), z);
+                        let tr = marched_transmittance::<M, f32>(
+                            medium,
+                            p,
+                            w,
+                            step,
+                            ShadowEnd::Cutoff,
+                            rng,
+                            c,
+                        );
+                        a += tr;
+                        b += tr * w;
+                    }
+                    let inv = 1.0 / env_dirs as f32;
+                    let b = b * inv;
+                    *slot = Vec4::new(a * inv, b.x, b.y, b.z);
+                }
             }
-            let inv = 1.0 / env_dirs as f32;
-            e[1] = a * inv;
-            [e[2], e[3], e[4]] = (b * inv).to_array();
         }
-        e
     }
 
+    /// The stored values of lattice point `(i, j, k)`, `None` in an empty
+    /// brick.
     #[inline]
-    fn entry(&self, i: usize, j: usize, k: usize) -> Entry {
+    fn entry(&self, i: usize, j: usize, k: usize) -> Option<&[Vec4]> {
         let bi = i / BRICK + self.bricks[0] * (j / BRICK + self.bricks[1] * (k / BRICK));
-        match &self.brick_data[bi] {
-            None => [0.0; 5],
-            Some(brick) => brick[i % BRICK + BRICK * (j % BRICK + BRICK * (k % BRICK))],
-        }
+        let o = i % BRICK + BRICK * (j % BRICK + BRICK * (k % BRICK));
+        let brick = self.brick_data[bi].as_ref()?;
+        Some(&brick[o * self.width..(o + 1) * self.width])
     }
 
     /// The lattice stencil at `p` (clamped to the lattice): its lowest
@@ -289,9 +307,18 @@ impl LightGrid {
     }
 
     /// Trilinear interpolation of the stored entries at `p` (clamped to
-    /// the lattice).
-    #[inline]
+    /// the lattice), collected.
+    #[cfg(test)]
     fn lookup(&self, p: Vec3) -> Entry {
+        let mut e = Entry::new();
+        self.lookup_each(p, |slot| e.push(slot));
+        e
+    }
+
+    /// Trilinear interpolation of the stored entries at `p` (clamped to
+    /// the lattice), each slot handed to `each` in turn.
+    #[inline]
+    fn lookup_each(&self, p: Vec3, mut each: impl FnMut(Vec4)) {
         let (base, f) = self.stencil(p);
         // Seven stencils in eight lie inside one brick: one brick lookup
         // and fixed offsets, where the path tracer's light choice asks at
@@ -299,36 +326,42 @@ impl LightGrid {
         // cloud's render).
         let inside = (0..3).all(|a| base[a] % BRICK != BRICK - 1 && self.points[a] >= 2);
         if !inside {
-            return self.blend(base, f);
+            self.blend(base, f).into_iter().for_each(each);
+            return;
         }
         let [i, j, k] = base;
         let bi = i / BRICK + self.bricks[0] * (j / BRICK + self.bricks[1] * (k / BRICK));
+        let w = self.width;
         let Some(brick) = &self.brick_data[bi] else {
-            return [0.0; 5];
+            (0..w).for_each(|_| each(Vec4::ZERO));
+            return;
         };
         let o = i % BRICK + BRICK * (j % BRICK + BRICK * (k % BRICK));
-        let corner = |d: usize| brick[o + d];
-        let lerp = |a: Entry, b: Entry, t: f32| std::array::from_fn(|n| a[n] + (b[n] - a[n]) * t);
         // x fastest in a brick: y one row of BRICK on, z one slice.
         const Y: usize = BRICK;
         const Z: usize = BRICK * BRICK;
-        let z0 = lerp(
-            lerp(corner(0), corner(1), f[0]),
-            lerp(corner(Y), corner(Y + 1), f[0]),
-            f[1],
-        );
-        let z1 = lerp(
-            lerp(corner(Z), corner(Z + 1), f[0]),
-            lerp(corner(Z + Y), corner(Z + Y + 1), f[0]),
-            f[1],
-        );
-        lerp(z0, z1, f[2])
+        let corners = &brick[o * w..(o + Z + Y + 2) * w];
+        let corner = |d: usize, n: usize| corners[d * w + n];
+        let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
+        for n in 0..w {
+            let z0 = lerp(
+                lerp(corner(0, n), corner(1, n), f[0]),
+                lerp(corner(Y, n), corner(Y + 1, n), f[0]),
+                f[1],
+            );
+            let z1 = lerp(
+                lerp(corner(Z, n), corner(Z + 1, n), f[0]),
+                lerp(corner(Z + Y, n), corner(Z + Y + 1, n), f[0]),
+                f[1],
+            );
+            each(lerp(z0, z1, f[2]));
+        }
     }
 
     /// The stencil at `base` blended corner by corner with fractions `f`,
     /// each corner found in its own brick.
     fn blend(&self, base: [usize; 3], f: [f32; 3]) -> Entry {
-        let mut out = [0.0; 5];
+        let mut out: Entry = smallvec::smallvec![Vec4::ZERO; self.width];
         for corner in 0..8 {
             let d = [corner & 1, (corner >> 1) & 1, corner >> 2];
             let mut w = 1.0;
@@ -338,7 +371,9 @@ impl LightGrid {
                 q[a] = (base[a] + d[a]).min(self.points[a] - 1);
             }
             if w > 0.0 {
-                let e = self.entry(q[0], q[1], q[2]);
+                let Some(e) = self.entry(q[0], q[1], q[2]) else {
+                    continue;
+                };
                 for (o, v) in out.iter_mut().zip(e) {
                     *o += w * v;
                 }
@@ -347,16 +382,28 @@ impl LightGrid {
         out
     }
 
-    /// What `p` sees of each light toward a ray travelling along `dir`:
-    /// the sun's transmittance, and the sky's two bands with the phase
-    /// function's mean cosine (see [`Entry`]).
-    pub(crate) fn seen(&self, phase: &Phase, p: Vec3, dir: Vec3) -> Seen {
-        let e = self.lookup(p);
-        let b = Vec3::new(e[2], e[3], e[4]);
-        let band = e[1] + 3.0 * phase.mean_cosine() * b.dot(dir);
-        Seen {
-            sun: e[0],
-            sky: band.max(0.0),
+    /// What `p` sees of each light the grid was built for (the lights
+    /// with no light dropped, [`Lights::pruned`]) toward a ray travelling
+    /// along `dir`: a distant light's transmittance, a dome's two bands
+    /// with the phase function's mean cosine (see [`Entry`]).
+    /// At most [`MAX_PICKED_LIGHTS`](super::light_choice::MAX_PICKED_LIGHTS) lights: the light choice's.
+    pub(crate) fn seen(&self, phase: &Phase, p: Vec3, dir: Vec3) -> PerLight {
+        let mut seen = PerLight::zeros(self.kinds.len());
+        let mut out = seen.iter_mut().zip(&self.kinds);
+        self.lookup_each(p, |slot| {
+            if let Some((seen, &kind)) = out.next() {
+                *seen = Self::seen_in(kind, slot, phase, dir);
+            }
+        });
+        seen
+    }
+
+    /// The fraction of a light of `kind` seen through a slot.
+    #[inline]
+    fn seen_in(kind: LightKind, slot: Vec4, phase: &Phase, dir: Vec3) -> f32 {
+        match kind {
+            LightKind::Distant => slot.x,
+            LightKind::Dome => (slot.x + 3.0 * phase.mean_cosine() * slot.yzw().dot(dir)).max(0.0),
         }
     }
 
@@ -371,15 +418,21 @@ impl LightGrid {
         p: Vec3,
         dir: Vec3,
     ) -> super::LightParts {
-        let seen = self.seen(phase, p, dir);
         let mut s = super::LightParts::default();
-        if let Some(sun) = &lights.sun {
-            let f = phase.eval(dir, -sun.direction());
-            s.sun = sun.irradiance() * (f * seen.sun);
-        }
-        if let Some(env) = &lights.environment {
-            s.sky = env.mean_radiance() * seen.sky;
-        }
+        let mut i = 0;
+        self.lookup_each(p, |slot| {
+            let light = lights.get(i);
+            let seen = Self::seen_in(light.kind(), slot, phase, dir);
+            let l = match light {
+                Light::Distant(sun) => {
+                    let f = phase.eval(dir, -sun.direction());
+                    sun.irradiance() * (f * seen)
+                }
+                Light::Dome(env) => env.mean_radiance() * seen,
+            };
+            s.add(lights.group(i), l);
+            i += 1;
+        });
         s
     }
 }
@@ -400,10 +453,10 @@ mod tests {
             (1.0 - 3.0 * r.length()).max(0.0) * (1.0 + (7.0 * r.x).sin() * (5.0 * r.z).cos())
         });
         let cloud = crate::volumes::Volumes::from(Medium::new(field, 20.0, Vec3::splat(0.9), 0.5));
-        let lights = Lights {
-            sun: Some(Sun::new(Vec3::new(0.3, -1.0, 0.2), Vec3::splat(3.0), 0.0)),
-            environment: Some(Environment::new(Vec3::splat(0.2))),
-        };
+        let lights = Lights::sun_and_sky(
+            Some(Sun::new(Vec3::new(0.3, -1.0, 0.2), Vec3::splat(3.0), 0.0)),
+            Some(Environment::new(Vec3::splat(0.2))),
+        );
         LightGrid::for_light_choice(&cloud, &lights)
     }
 
@@ -427,14 +480,14 @@ mod tests {
             let (base, f) = grid.stencil(p);
             let fast = grid.lookup(p);
             let blended = grid.blend(base, f);
-            for (a, b) in fast.iter().zip(blended) {
+            for (a, b) in fast.iter().zip(&blended) {
                 assert!(
-                    (a - b).abs() <= 1e-5,
+                    (*a - *b).abs().max_element() <= 1e-5,
                     "at {p}: {fast:?} against {blended:?}"
                 );
             }
-            lo = lo.min(fast[0]);
-            hi = hi.max(fast[0]);
+            lo = lo.min(fast[0].x);
+            hi = hi.max(fast[0].x);
         }
         assert!(lo < 0.05 && hi > 0.9, "sun transmittance from {lo} to {hi}");
     }

@@ -17,7 +17,7 @@
 use glam::Vec3;
 
 use super::{escaped_radiance, LightParts, Sample};
-use crate::compositing::{tag, GroupRadiance, LightGroup};
+use crate::compositing::GroupRadiance;
 use crate::light::Lights;
 use crate::medium::{Lattice, Media};
 use crate::phase::Phase;
@@ -191,12 +191,8 @@ pub(crate) fn march_camera_ray<M: Media, E: Spectrum>(
             held += step.mean();
         } else {
             l += step.tint(source);
-            parts.scaled(step.tint(it.albedo * weight)).tag(&mut groups);
-            tag(
-                &mut groups,
-                LightGroup::Emission,
-                step.tint(emitted * weight),
-            );
+            parts.tag_scaled(step.tint(it.albedo * weight), &mut groups);
+            groups[lights.emission_group()] += step.tint(emitted * weight);
         }
         tr = tr.mul(step_tr);
         tr.roulette(rng)
@@ -205,7 +201,7 @@ pub(crate) fn march_camera_ray<M: Media, E: Spectrum>(
     if ray.t_max.is_infinite() {
         let parts = escaped_radiance(lights, ray.dir, None, c);
         l += tr.tint(parts.total());
-        parts.scaled(tr.tint(Vec3::ONE)).tag(&mut groups);
+        parts.tag_scaled(tr.tint(Vec3::ONE), &mut groups);
     }
     Sample {
         radiance: l,

@@ -29,7 +29,7 @@ pub use sunward_mode::{Sunward, FORWARD_MEAN_COSINE};
 use glam::Vec3;
 
 use crate::compositing::GroupRadiance;
-use crate::light::Lights;
+use crate::light::{LightKind, Lights};
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Rng, SampleStream};
 use crate::stats::Counters;
@@ -106,63 +106,64 @@ pub trait CameraSampler: Sync {
 /// Radiance reaching an escaping ray along `dir` from lights at infinity.
 ///
 /// `phase_pdf` is the solid-angle pdf with which `dir` was phase-sampled,
-/// `None` for camera rays (which no light strategy could have produced, so
-/// they take the full radiance). Otherwise each light's radiance is weighted
-/// by the power heuristic against that light's own sampling pdf, the
-/// counterpart of the weights in next-event estimation.
+/// with the light choice at its vertex, `None` for camera rays (which no
+/// light strategy could have produced, so they take the full radiance).
+/// Otherwise each light's radiance is weighted by the power heuristic
+/// against that light's own sampling pdf times the probability that the
+/// vertex sampled it (`light_choice.rs`), the counterpart of the weights in
+/// next-event estimation.
 pub(crate) fn escaped_radiance(
     lights: &Lights,
     dir: Vec3,
-    phase_pdf: Option<(f32, LightChoice)>,
+    phase_pdf: Option<(f32, &LightChoice)>,
     c: &mut Counters,
 ) -> LightParts {
-    // The light strategy's density is the light's own times the
-    // probability that the vertex picked it (`light_choice.rs`).
-    let weight = |light_pdf: f32, pick: fn(LightChoice) -> f32| {
-        phase_pdf.map_or(1.0, |(p, choice)| {
-            power_heuristic(p, pick(choice) * light_pdf)
-        })
-    };
     let mut l = LightParts::default();
-    if let Some(env) = &lights.environment {
-        c.env_samples += 1;
-        let (radiance, pdf) = env.eval(dir);
-        l.sky = radiance * weight(pdf, |c| c.sky);
-    }
-    if let Some((radiance, pdf)) = lights.sun.as_ref().and_then(|s| s.hit(dir)) {
-        l.sun = radiance * weight(pdf, |c| c.sun);
+    for (i, light) in lights.iter().enumerate() {
+        c.dome_samples += u64::from(light.kind() == LightKind::Dome);
+        if let Some((radiance, pdf)) = light.escaped(dir) {
+            let weight = phase_pdf.map_or(1.0, |(p, choice)| {
+                power_heuristic(p, choice.probability(i) * pdf)
+            });
+            l.add(lights.group(i), radiance * weight);
+        }
     }
     l
 }
 
-/// Light arriving from each of the lights at infinity, kept apart for the
-/// light groups; [`LightParts::total`] is what the integrators add.
+/// Light gathered from the lights, in all and by light group; the
+/// integrators add [`LightParts::total`], the film's light groups the
+/// parts.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct LightParts {
-    pub sun: Vec3,
-    pub sky: Vec3,
+    total: Vec3,
+    groups: GroupRadiance,
 }
 
 impl LightParts {
-    /// The sum, as the integrators always added it (0 + sky + sun).
+    /// Adds `l`, from a light of group `group`.
     #[inline]
-    pub fn total(self) -> Vec3 {
-        self.sky + self.sun
+    pub fn add(&mut self, group: usize, l: Vec3) {
+        self.total += l;
+        self.groups[group] += l;
     }
 
     #[inline]
-    pub fn scaled(self, w: Vec3) -> Self {
-        Self {
-            sun: self.sun * w,
-            sky: self.sky * w,
+    pub fn total(&self) -> Vec3 {
+        self.total
+    }
+
+    /// The part of light group `g`.
+    #[cfg(test)]
+    pub fn group(&self, g: usize) -> Vec3 {
+        self.groups[g]
+    }
+
+    /// Adds each group's part, times `w`, to `groups`.
+    #[inline]
+    pub fn tag_scaled(&self, w: Vec3, groups: &mut GroupRadiance) {
+        for (g, part) in groups.iter_mut().zip(&self.groups) {
+            *g += *part * w;
         }
-    }
-
-    /// Adds each part to its light's group.
-    #[inline]
-    pub fn tag(self, groups: &mut GroupRadiance) {
-        use crate::compositing::{tag, LightGroup};
-        tag(groups, LightGroup::Sun, self.sun);
-        tag(groups, LightGroup::Sky, self.sky);
     }
 }

@@ -3,17 +3,18 @@
 
 use glam::Vec3;
 
-use super::light_choice::{LightChoice, LightSampling};
-use super::light_grid::{LightGrid, Seen};
+use super::light_choice::{LightChoice, LightSampling, PerLight};
+use super::light_grid::LightGrid;
 use super::path_state::{Arrival, At, Escape, Path, Vertex};
 use super::sunward_mode::Sunward;
 use super::{escaped_radiance, AovSample, CameraSampler, Sample};
-use crate::compositing::{tag, GroupRadiance, LightGroup};
-use crate::light::Lights;
+use crate::compositing::GroupRadiance;
+use crate::light::{Light, Lights, Sun};
 use crate::medium::{Interaction, Media};
 use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::{Draw, Rng, SampleStream};
+use crate::spectrum::luminance;
 use crate::spectrum::Spectrum;
 use crate::stats::Counters;
 use crate::tracking::{sample_free_flight, FreeFlight, TransmittanceEstimator};
@@ -34,10 +35,10 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 ///   absorption events). This is lower variance than stochastic absorption
 ///   and a coloured albedo comes for free; Russian roulette does the
 ///   terminating instead.
-/// - Next-event estimation at every scattering event: one sample of the
-///   sun (if any) and one of the environment (if any), or of one of them
-///   picked at random ([`LightSampling`]; weighed through the media by a
-///   shadow grid where one is given, and then sometimes none), each
+/// - Next-event estimation at every scattering event: one sample of each
+///   light, or of one picked at random ([`LightSampling`]; weighed through
+///   the media by a shadow grid where one is given, and then sometimes
+///   none), each
 ///   shadow ray's transmittance estimated by the chosen estimator. Directions from a
 ///   light sampler and from phase sampling are combined with the power
 ///   heuristic (Veach 1997); a delta sun gets NEE only. At the last
@@ -66,10 +67,11 @@ pub const ROULETTE_THROUGHPUT: f32 = 0.1;
 /// - Directions: the phase function's, sampled exactly (its density is
 ///   its value), so NEE's MIS weights and escaped light's take it.
 /// - Sunward scattering ([`Sunward`], `path_sunward.rs`): at a vertex
-///   with a forward-peaked phase function under a sun, a second direction
-///   drawn from the phase lobe about the sun gathers the sun's light at
-///   its collision, weighed by MIS against the sun's next-event estimate
-///   at the path's own next vertex (which takes the complementary weight).
+///   with a forward-peaked phase function under a distant light (the
+///   brightest, where there are several), a second direction drawn from
+///   the phase lobe about that light gathers its light at its collision,
+///   weighed by MIS against the light's next-event estimate at the path's
+///   own next vertex (which takes the complementary weight).
 /// - Emission: at every real collision, with the instance chosen with
 ///   probability `sigma_t,i / sigma_t` ([`Media::interaction`]), the
 ///   path adds `beta * (1 - albedo_i) * Le_i`. Delta tracking samples the
@@ -91,6 +93,8 @@ pub struct PathTracer<'a, M> {
     /// Where the next vertex's sunlight is gathered by sunward scattering
     /// as well ([`Sunward`]).
     pub(super) sunward: Sunward,
+    /// The distant light sunward scattering draws toward: the brightest.
+    pub(super) sunward_light: Option<usize>,
     /// Each light's transmittance through the media, which the light
     /// choice weighs lights by (`light_choice.rs`).
     pub(super) shadows: Option<&'a LightGrid>,
@@ -104,8 +108,17 @@ impl<'a, M: Media> PathTracer<'a, M> {
         max_depth: Option<u32>,
     ) -> Self {
         let lights = lights.pruned();
+        let sunward_light = lights
+            .distant()
+            .map(|(i, sun)| (i, luminance(sun.irradiance())))
+            .fold(None, |best: Option<(usize, f32)>, (i, e)| match best {
+                Some((_, b)) if b >= e => best,
+                _ => Some((i, e)),
+            })
+            .map(|(i, _)| i);
         Self {
             medium,
+            sunward_light,
             light_sampling: LightSampling::default().resolve(&lights),
             lights,
             estimator,
@@ -135,7 +148,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     /// What the vertex at `p`, reached along `dir_in`, sees of each light
     /// through the media, where a shadow grid is given.
     #[inline]
-    pub(super) fn seen(&self, phase: &Phase, p: Vec3, dir_in: Vec3) -> Option<Seen> {
+    pub(super) fn seen(&self, phase: &Phase, p: Vec3, dir_in: Vec3) -> Option<PerLight> {
         self.shadows.map(|grid| grid.seen(phase, p, dir_in))
     }
 
@@ -146,7 +159,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         &self,
         phase: &Phase,
         dir_in: Vec3,
-        seen: Option<Seen>,
+        seen: Option<&PerLight>,
     ) -> LightChoice {
         match seen {
             Some(seen) if self.light_sampling == LightSampling::One => {
@@ -176,6 +189,16 @@ impl<'a, M: Media> PathTracer<'a, M> {
     /// where `sunward` says.
     pub fn with_sunward(self, sunward: Sunward) -> Self {
         Self { sunward, ..self }
+    }
+
+    /// The distant light sunward scattering draws toward, with its index.
+    #[inline]
+    pub(super) fn sunward_sun(&self) -> Option<(usize, &Sun)> {
+        let i = self.sunward_light?;
+        match self.lights.get(i) {
+            Light::Distant(sun) => Some((i, sun)),
+            Light::Dome(_) => None,
+        }
     }
 }
 
@@ -255,14 +278,14 @@ impl<M: Media> PathTracer<'_, M> {
     fn escape(&self, path: &mut Path, c: &mut Counters) {
         // A camera ray ended by a depth holdout: what lies behind the
         // held-out geometry, the sky included, never shows.
-        let pdf = match path.escape {
+        let pdf = match &path.escape {
             _ if path.emission_only || path.ray.t_max.is_finite() => return,
             Escape::Full => None,
-            Escape::Mis(pdf, choice) => Some((pdf, choice)),
+            Escape::Mis(pdf, choice) => Some((*pdf, choice)),
         };
         let parts = escaped_radiance(&self.lights, path.ray.dir, pdf, c);
         let e = path.beta * parts.total();
-        path.add(e, Some(parts), self.light_groups);
+        path.add(e, &parts, self.light_groups);
         if path.depth == 1 {
             path.out.aov.direct += e;
         }
@@ -333,12 +356,12 @@ impl<M: Media> PathTracer<'_, M> {
             phase: at.phase,
             mis: !last,
             index: vertex,
-            choice: self.light_choice(at.phase, ray_in.dir, seen),
+            choice: self.light_choice(at.phase, ray_in.dir, seen.as_ref()),
             arrival: path.arrival,
         };
         let parts = self.direct_light::<S>(&v, draws, c);
         let direct = path.beta * parts.total();
-        path.add(direct, Some(parts), self.light_groups);
+        path.add(direct, &parts, self.light_groups);
         if path.depth == 1 {
             path.out.aov.direct += direct;
         }
@@ -350,10 +373,10 @@ impl<M: Media> PathTracer<'_, M> {
         }
         // The sunward strategy gathers the next vertex's sunlight beside
         // the continuation (`path_sunward.rs`).
-        let lobe = self.sunward_lobe(path, at, ray_in.dir, seen);
+        let lobe = self.sunward_lobe(path, at, ray_in.dir, seen.as_ref());
         if let Some(lobe) = &lobe {
             let e = self.sunward::<S>(path, at, lobe, &ray_in, draws, c);
-            path.add_sun(e, self.light_groups);
+            path.add_to_group(e, self.lights.group(lobe.light), self.light_groups);
         }
         // The phase function is sampled exactly: the direction's weight
         // `f / pdf` is 1, and its density is `f`.
@@ -372,11 +395,8 @@ impl<M: Media> PathTracer<'_, M> {
     fn emit(&self, path: &mut Path, p: Vec3, it: &Interaction, c: &mut Counters) {
         let le = self.medium.emission(p, path.ray.time, it.instance, c);
         let e = path.beta * (Vec3::ONE - it.albedo) * le;
-        path.add(e, None, false);
+        path.add_to_group(e, self.lights.emission_group(), self.light_groups);
         path.out.aov.emission += e;
-        if self.light_groups {
-            tag(&mut path.out.groups, LightGroup::Emission, e);
-        }
     }
 
     /// Russian roulette on the throughput once it is small; false when the

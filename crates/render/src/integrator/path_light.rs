@@ -1,14 +1,15 @@
 //! Next-event estimation for the path tracer: one sample of each light at
-//! a scattering vertex, or of one light picked by `light_choice.rs`, its
-//! shadow ray's transmittance by the chosen estimator, weighted against the scattered direction's density by the
-//! power heuristic (Veach 1997).
+//! a scattering vertex, or of the lights picked by `light_choice.rs`, each
+//! shadow ray's transmittance by the chosen estimator, weighted against
+//! the scattered direction's density by the power heuristic (Veach 1997).
 
 use glam::Vec3;
 
+use super::light_choice::LightChoice;
 use super::path::PathTracer;
 use super::path_state::Vertex;
 use super::LightParts;
-use crate::light::{Environment, LightSample};
+use crate::light::{Environment, Light, LightSample};
 use crate::medium::Media;
 use crate::sampling::{power_heuristic, Draw, SampleStream};
 use crate::spectrum::Spectrum;
@@ -16,39 +17,72 @@ use crate::stats::Counters;
 use crate::tracking::transmittance;
 
 impl<M: Media> PathTracer<'_, M> {
-    /// NEE at a vertex: one sample of the sun and one of the sky, or of
-    /// one of them picked by `v.choice` (the pick drawn from the hashed
-    /// stream, so the lights' Sobol dimensions stay where they are).
+    /// NEE at a vertex: one sample of every light, or of the lights
+    /// `v.choice` picks (the pick drawn from the hashed stream, so the
+    /// lights' Sobol dimensions stay where they are); the `k`-th sample
+    /// the vertex takes draws [`Draw::LightDirection`]`(k)` and
+    /// [`Draw::LightShadow`]`(k)`.
     pub(super) fn direct_light<S: Spectrum>(
         &self,
         v: &Vertex,
         draws: &mut SampleStream,
         c: &mut Counters,
     ) -> LightParts {
-        let (sun_picked, sky_picked) = if v.choice.is_all() {
-            (true, true)
-        } else {
-            // Sun, sky, or (where the choice traces no shadow ray with the
-            // remaining probability) neither; both where they sum past one.
-            v.choice.picks(draws.rng().uniform())
-        };
         let mut l = LightParts::default();
-        if let Some(sun) = self.lights.sun.as_ref().filter(|_| sun_picked) {
-            let (u1, u2) = draws.get_2d(Draw::SunDirection, v.index);
-            let s = sun.sample(u1, u2);
-            c.nee_rays_sun += 1;
-            let weight = v.arrival.sun_weight(v.choice.sun);
-            l.sun = weight * self.light_term::<S>(v, s, v.choice.sun, Draw::SunShadow, draws, c);
-        }
-        if let Some(env) = self.lights.environment.as_ref().filter(|_| sky_picked) {
-            let (u1, u2) = draws.get_2d(Draw::SkyDirection, v.index);
-            let s = self.sky_sample(v, env, u1, u2);
-            c.env_samples += 1;
-            // A zero-density sample (a pole) is dropped without a shadow ray.
-            c.nee_rays_env += u64::from(s.pdf.is_some_and(|p| p > 0.0));
-            l.sky = self.light_term::<S>(v, s, v.choice.sky, Draw::SkyShadow, draws, c);
+        match &v.choice {
+            LightChoice::All => {
+                for (k, i) in (0..self.lights.len()).enumerate() {
+                    let e = self.light_sample::<S>(v, i, 1.0, k as u32, draws, c);
+                    l.add(self.lights.group(i), e);
+                }
+            }
+            LightChoice::Pick(p) => {
+                // Where the probabilities sum below one the vertex samples
+                // no light with the rest; past one, sometimes two.
+                let u = draws.rng().uniform();
+                for (k, i) in LightChoice::picks(p, u).enumerate() {
+                    let e = self.light_sample::<S>(v, i, p[i], k as u32, draws, c);
+                    l.add(self.lights.group(i), e);
+                }
+            }
         }
         l
+    }
+
+    /// The `k`-th light sample at `v`: light `i`, which the vertex samples
+    /// with probability `pick`.
+    fn light_sample<S: Spectrum>(
+        &self,
+        v: &Vertex,
+        i: usize,
+        pick: f32,
+        k: u32,
+        draws: &mut SampleStream,
+        c: &mut Counters,
+    ) -> Vec3 {
+        let (u1, u2) = draws.get_2d(Draw::LightDirection(k), v.index);
+        let shadow = Draw::LightShadow(k);
+        match self.lights.get(i) {
+            Light::Distant(sun) => {
+                let s = sun.sample(u1, u2);
+                c.nee_rays_distant += 1;
+                // The sunward light's estimate shares its light with
+                // sunward scattering at the previous vertex.
+                let weight = if self.sunward_light == Some(i) {
+                    v.arrival.sun_weight(pick)
+                } else {
+                    1.0
+                };
+                weight * self.light_term::<S>(v, s, pick, shadow, draws, c)
+            }
+            Light::Dome(env) => {
+                let s = self.sky_sample(v, env, u1, u2);
+                c.dome_samples += 1;
+                // A zero-density sample (a pole) is dropped without a shadow ray.
+                c.nee_rays_dome += u64::from(s.pdf.is_some_and(|p| p > 0.0));
+                self.light_term::<S>(v, s, pick, shadow, draws, c)
+            }
+        }
     }
 
     /// The sky's direction at `v`: drawn from the sky itself, except for a

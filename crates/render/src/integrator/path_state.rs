@@ -9,7 +9,6 @@ use glam::Vec3;
 
 use super::light_choice::LightChoice;
 use super::{LightParts, Sample};
-use crate::compositing::{tag, LightGroup};
 use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampling::power_heuristic;
@@ -54,24 +53,22 @@ pub(super) struct Path {
 
 impl Path {
     /// Adds light `parts` reaching the path (throughput included in
-    /// `total`), to the pixel and its light groups.
+    /// `total`), to the pixel and, where `groups`, its light groups.
     #[inline]
-    pub(super) fn add(&mut self, total: Vec3, parts: Option<LightParts>, groups: bool) {
+    pub(super) fn add(&mut self, total: Vec3, parts: &LightParts, groups: bool) {
         self.out.radiance += total;
         if groups {
-            if let Some(parts) = parts {
-                parts.scaled(self.beta).tag(&mut self.out.groups);
-            }
+            parts.tag_scaled(self.beta, &mut self.out.groups);
         }
     }
 
-    /// Adds sunlight `e` (throughput included) gathered beside the path's
-    /// own vertices.
+    /// Adds light `e` (throughput included) of light group `group`,
+    /// gathered beside the path's own vertices or emitted.
     #[inline]
-    pub(super) fn add_sun(&mut self, e: Vec3, groups: bool) {
+    pub(super) fn add_to_group(&mut self, e: Vec3, group: usize, groups: bool) {
         self.out.radiance += e;
         if groups {
-            tag(&mut self.out.groups, LightGroup::Sun, e);
+            self.out.groups[group] += e;
         }
     }
 }
@@ -94,8 +91,8 @@ pub(super) struct Vertex<'a> {
     pub arrival: Arrival,
 }
 
-/// How the direction a path travels along was drawn: what the sun's
-/// next-event estimate at its next vertex weighs itself by.
+/// How the direction a path travels along was drawn: what the sunward
+/// light's next-event estimate at its next vertex weighs itself by.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Arrival {
     /// The continuation's scattering density of the direction.
@@ -107,8 +104,8 @@ pub(super) struct Arrival {
 }
 
 impl Arrival {
-    /// The weight of the sun's next-event estimate at the vertex this
-    /// arrival reaches, where the sun is picked with probability `pick`.
+    /// The weight of the sunward light's next-event estimate at the vertex
+    /// this arrival reaches, where it is picked with probability `pick`.
     #[inline]
     pub fn sun_weight(self, pick: f32) -> f32 {
         if self.sunward_pdf > 0.0 {

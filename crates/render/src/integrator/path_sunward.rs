@@ -42,8 +42,7 @@
 
 use glam::Vec3;
 
-use super::light_choice::LightChoice;
-use super::light_grid::Seen;
+use super::light_choice::{LightChoice, PerLight};
 use super::path::PathTracer;
 use super::path_state::{At, Path};
 use crate::medium::Media;
@@ -90,6 +89,8 @@ fn sunward_weight(q: f32, f: f32, pick: f32) -> f32 {
 /// function `phase`: that phase function's lobe about `to_sun`.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct SunwardLobe<'a> {
+    /// The distant light's index in the tracer's lights.
+    pub light: usize,
     phase: &'a Phase,
     dir_in: Vec3,
     to_sun: Vec3,
@@ -108,32 +109,29 @@ impl<M: Media> PathTracer<'_, M> {
         path: &Path,
         at: &At<'p>,
         dir_in: Vec3,
-        seen: Option<Seen>,
+        seen: Option<&PerLight>,
     ) -> Option<SunwardLobe<'p>> {
-        let sun = self.lights.sun.as_ref()?;
+        let (light, sun) = self.sunward_sun()?;
         let last = self.max_depth.is_some_and(|m| path.depth >= m);
         if last || !self.sunward.runs_at(at.phase) {
             return None;
         }
         Some(SunwardLobe {
+            light,
             phase: at.phase,
             dir_in,
             to_sun: -sun.direction(),
-            lit: seen.map_or(1.0, |seen| (seen.sun / LIT_FRACTION).min(1.0)),
+            lit: seen.map_or(1.0, |seen| (seen[light] / LIT_FRACTION).min(1.0)),
         })
     }
 
-    /// The probability that a vertex whose phase function toward the sun
-    /// is `f_sun` samples the sun, unoccluded (an estimate: the keep
-    /// probability only needs to be the same for both strategies).
+    /// The probability that a vertex whose phase function toward the
+    /// sunward light `light` is `f_sun` samples it, unoccluded (an
+    /// estimate: the keep probability only needs to be the same for both
+    /// strategies).
     #[inline]
-    fn sun_pick(&self, f_sun: f32) -> f32 {
-        let pick = LightChoice::facing_sun(self.light_sampling, &self.lights, f_sun);
-        if pick.is_all() {
-            1.0
-        } else {
-            pick.sun
-        }
+    fn sun_pick(&self, light: usize, f_sun: f32) -> f32 {
+        LightChoice::facing(self.light_sampling, &self.lights, light, f_sun)
     }
 
     /// [`keep_probability`] with the sun's pick at the next vertex
@@ -141,8 +139,8 @@ impl<M: Media> PathTracer<'_, M> {
     /// sun at a lobe draw is the lobe's density `q`): any keep probability
     /// is exact, so long as both strategies' weights use the same one.
     #[inline]
-    fn keep(&self, q: f32, f: f32, lit: f32) -> f32 {
-        keep_probability(q, f, self.sun_pick(q), lit)
+    fn keep(&self, lobe: &SunwardLobe, q: f32, f: f32) -> f32 {
+        keep_probability(q, f, self.sun_pick(lobe.light, q), lobe.lit)
     }
 
     /// The sunward strategy's density at direction `w`, where the phase
@@ -150,7 +148,7 @@ impl<M: Media> PathTracer<'_, M> {
     #[inline]
     pub(super) fn sunward_pdf(&self, lobe: &SunwardLobe, w: Vec3, f: f32) -> f32 {
         let q = lobe.phase.eval(lobe.to_sun, w);
-        q * self.keep(q, f, lobe.lit)
+        q * self.keep(lobe, q, f)
     }
 
     /// The sunward estimate at vertex `at` (reached along `ray_in`) of the
@@ -171,7 +169,7 @@ impl<M: Media> PathTracer<'_, M> {
         if !(q > 0.0 && f > 0.0) {
             return Vec3::ZERO;
         }
-        let keep = self.keep(q, f, lobe.lit);
+        let keep = self.keep(lobe, q, f);
         if rng.uniform() >= keep {
             return Vec3::ZERO;
         }
@@ -189,7 +187,7 @@ impl<M: Media> PathTracer<'_, M> {
             beta *= it.weight;
         }
         beta *= it.albedo;
-        let Some(sun) = self.lights.sun.as_ref() else {
+        let Some((light, sun)) = self.sunward_sun() else {
             return Vec3::ZERO;
         };
         if beta.max_element() <= 0.0 {
@@ -199,8 +197,8 @@ impl<M: Media> PathTracer<'_, M> {
         // with this probability (its shadow grid's, as the continuation's
         // own vertex there computes it).
         let pick = self
-            .light_choice(it.phase, w, self.seen(it.phase, p, w))
-            .sun;
+            .light_choice(it.phase, w, self.seen(it.phase, p, w).as_ref())
+            .probability(light);
         let weight = sunward_weight(q, f, pick);
         let s = sun.sample(rng.uniform(), rng.uniform());
         let f_sun = it.phase.eval(w, s.to_light);
@@ -219,7 +217,7 @@ impl<M: Media> PathTracer<'_, M> {
             }
             Some(_) => return Vec3::ZERO,
         };
-        c.nee_rays_sun += 1;
+        c.nee_rays_distant += 1;
         let shadow = ray.spawn(p, s.to_light);
         let tr = transmittance::<S, M>(self.estimator, self.medium, &shadow, f32::INFINITY, rng, c);
         beta * s.radiance * (f_sun * light_weight * weight * tr.rgb())
@@ -287,11 +285,11 @@ mod tests {
     /// the continuation's weight without the kept fraction misses it.
     #[test]
     fn both_strategies_together_give_the_convolved_phase_function() {
-        let lights = Lights {
-            sun: Some(Sun::new(Vec3::new(0.0, -1.0, 0.0), Vec3::splat(2.0), 0.0)),
-            environment: Some(Environment::new(Vec3::splat(0.3))),
-        };
-        let one = |f_sun: f32| LightChoice::facing_sun(LightSampling::One, &lights, f_sun).sun;
+        let lights = Lights::sun_and_sky(
+            Some(Sun::new(Vec3::new(0.0, -1.0, 0.0), Vec3::splat(2.0), 0.0)),
+            Some(Environment::new(Vec3::splat(0.3))),
+        );
+        let one = |f_sun: f32| LightChoice::facing(LightSampling::One, &lights, 0, f_sun);
         let all = |_: f32| 1.0f32;
         let s = Vec3::Y;
         let n = 400_000;

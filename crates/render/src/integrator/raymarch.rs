@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::march::{march_camera_ray, marched_transmittance, ShadowEnd};
 use super::{CameraSampler, LightParts, Sample};
-use crate::light::Lights;
+use crate::light::{Light, Lights};
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
@@ -65,23 +65,16 @@ impl<'a, M: Media> RayMarcher<'a, M> {
         c: &mut Counters,
     ) -> LightParts {
         let mut s = LightParts::default();
-        if let Some(sun) = &self.lights.sun {
-            // Sampling the disc uniformly: radiance / pdf is the irradiance.
-            let ls = sun.sample(rng.uniform(), rng.uniform());
-            let f = phase.eval(dir, ls.to_light);
-            let tr: E = marched_transmittance(
-                self.medium,
-                p,
-                ls.to_light,
-                self.shadow_step,
-                ShadowEnd::Roulette,
-                rng,
-                c,
-            );
-            s.sun = tr.scale(f).tint(sun.irradiance());
-        }
-        if let Some(env) = &self.lights.environment {
-            let (w, _) = phase.sample(dir, rng.uniform(), rng.uniform());
+        for (i, light) in self.lights.iter().enumerate() {
+            // A distant light's disc sampled uniformly (radiance / pdf is
+            // the irradiance); a dome along a phase-sampled direction.
+            let (w, f) = match light {
+                Light::Distant(sun) => {
+                    let ls = sun.sample(rng.uniform(), rng.uniform());
+                    (ls.to_light, phase.eval(dir, ls.to_light))
+                }
+                Light::Dome(_) => (phase.sample(dir, rng.uniform(), rng.uniform()).0, 1.0),
+            };
             let tr: E = marched_transmittance(
                 self.medium,
                 p,
@@ -91,8 +84,14 @@ impl<'a, M: Media> RayMarcher<'a, M> {
                 rng,
                 c,
             );
-            c.env_samples += 1;
-            s.sky = tr.tint(env.eval(w).0);
+            let l = match light {
+                Light::Distant(sun) => tr.scale(f).tint(sun.irradiance()),
+                Light::Dome(env) => {
+                    c.dome_samples += 1;
+                    tr.tint(env.eval(w).0)
+                }
+            };
+            s.add(self.lights.group(i), l);
         }
         s
     }

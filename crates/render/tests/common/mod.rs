@@ -76,10 +76,7 @@ where
 /// The 20x20 cloud (density 8, albedo 0.9, g 0.5) under a 2-degree sun
 /// and a blue sky: the scene the thread-count and film tests share.
 pub fn sunlit_cloud() -> Scene<Volumes<GridField>> {
-    let lights = Lights {
-        sun: sun(2.0),
-        environment: env(Vec3::new(0.2, 0.3, 0.45)),
-    };
+    let lights = Lights::sun_and_sky(sun(2.0), env(Vec3::new(0.2, 0.3, 0.45)));
     scene(medium(cloud_field(4), 8.0, 0.9, 0.5), 20, lights)
 }
 
