@@ -12,8 +12,10 @@
 //! forward-scattering vertex facing the sun takes the sun and one facing
 //! away takes the sky; every light keeps a defensive share of at least
 //! `min(MIN_PROBABILITY, 1 / 2n)` of the `n` lights (with two, a
-//! probability within [`MIN_PROBABILITY`, 1 - `MIN_PROBABILITY`]), so no
+//! probability within [0.05, 0.95]: [`MIN_PROBABILITY`]), so no
 //! light is starved where the weights are wrong.
+//!
+//! [`MIN_PROBABILITY`]: super::per_light::MIN_PROBABILITY
 //!
 //! The probabilities are laid end to end around the unit interval and one
 //! number picks ([`LightChoice::picks`]): each light is sampled with its
@@ -46,6 +48,8 @@
 
 use glam::Vec3;
 
+use super::per_light::{into_shares, raise_to_floors, Shares};
+pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
 use crate::light::{Light, Lights};
 use crate::phase::Phase;
 use crate::sampling::UNIFORM_SPHERE_PDF;
@@ -88,9 +92,6 @@ impl LightSampling {
     }
 }
 
-/// A pick probability is at least this.
-pub const MIN_PROBABILITY: f32 = 0.05;
-
 /// A vertex whose lights, seen through the media, bring at least this
 /// fraction of their unoccluded in-scattered radiance always traces a
 /// shadow ray; one that expects less traces in proportion. Measured at 64
@@ -127,52 +128,6 @@ pub fn disc_floor(f: f32, solid_angle: f32) -> f32 {
         floor.min(1.0)
     } else {
         1.0
-    }
-}
-
-/// The most lights a vertex picks among; a scene with more samples every
-/// light ([`LightSampling::resolve`]).
-///
-/// The pick is computed at every vertex and carried to the next one for
-/// the escaped ray's weight, so its probabilities are a plain array on the
-/// stack: a growable one (with its spill checks and drops) cost the thick
-/// benchmark cloud a sixth of its render time. Many lights want a sampler
-/// that does not weigh each of them at every vertex (a light tree) rather
-/// than a longer array.
-pub const MAX_PICKED_LIGHTS: usize = 8;
-
-/// One value per light, in the order of [`Lights`] (at most
-/// [`MAX_PICKED_LIGHTS`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct PerLight {
-    values: [f32; MAX_PICKED_LIGHTS],
-    len: usize,
-}
-
-impl PerLight {
-    /// `n` zeros (`n` at most [`MAX_PICKED_LIGHTS`]).
-    #[inline]
-    pub fn zeros(n: usize) -> Self {
-        debug_assert!(n <= MAX_PICKED_LIGHTS);
-        Self {
-            values: [0.0; MAX_PICKED_LIGHTS],
-            len: n.min(MAX_PICKED_LIGHTS),
-        }
-    }
-}
-
-impl std::ops::Deref for PerLight {
-    type Target = [f32];
-    #[inline]
-    fn deref(&self) -> &[f32] {
-        &self.values[..self.len]
-    }
-}
-
-impl std::ops::DerefMut for PerLight {
-    #[inline]
-    fn deref_mut(&mut self) -> &mut [f32] {
-        &mut self.values[..self.len]
     }
 }
 
@@ -323,105 +278,13 @@ fn weigh(lights: &Lights, i: usize, phase: &Phase, dir_in: Vec3) -> (f32, f32) {
     }
 }
 
-/// Weights' shares of their sum, every share at least the defensive floor
-/// `min(MIN_PROBABILITY, 1 / (2 n))` (those above it scaled down to make
-/// room), so that no light is starved where the weights are wrong; equal
-/// shares where the weights sum to nothing or overflow.
-#[derive(Clone, Copy, Debug)]
-struct Shares {
-    total: f32,
-    floor: f32,
-    /// What a share above the floor is multiplied by (exactly 1 where no
-    /// share is below it).
-    scale: f32,
-    /// `Some(1 / n)` where the weights say nothing.
-    equal: Option<f32>,
-}
-
-impl Shares {
-    #[inline]
-    fn of(weights: impl Iterator<Item = f32> + Clone) -> Self {
-        let (n, total) = weights
-            .clone()
-            .fold((0u32, 0.0f32), |(n, t), w| (n + 1, t + w));
-        Self::with_total(weights, n, total)
-    }
-
-    /// [`Self::of`] `n` weights known to sum to `total`.
-    #[inline]
-    fn with_total(weights: impl Iterator<Item = f32>, n: u32, total: f32) -> Self {
-        let floor = if n < 2 {
-            0.0
-        } else {
-            MIN_PROBABILITY.min(0.5 / n as f32)
-        };
-        let mut shares = Self {
-            total,
-            floor,
-            scale: 1.0,
-            equal: None,
-        };
-        if !(total > 0.0 && total.is_finite()) {
-            shares.equal = Some(1.0 / n as f32);
-            return shares;
-        }
-        let (mut low, mut high) = (0u32, 0.0f32);
-        for w in weights {
-            let p = w / total;
-            if p < floor {
-                low += 1;
-            } else {
-                high += p;
-            }
-        }
-        if low > 0 {
-            shares.scale = (1.0 - floor * low as f32) / high;
-        }
-        shares
-    }
-
-    /// The share of weight `w`, one of those the shares were made of.
-    #[inline]
-    fn share(self, w: f32) -> f32 {
-        if let Some(equal) = self.equal {
-            return equal;
-        }
-        let p = w / self.total;
-        if p < self.floor {
-            self.floor
-        } else if self.scale == 1.0 {
-            p
-        } else {
-            p * self.scale
-        }
-    }
-}
-
-/// Turns weights into their [`Shares`].
-#[inline]
-fn into_shares(p: &mut [f32]) {
-    let shares = Shares::of(p.iter().copied());
-    for p in p.iter_mut() {
-        *p = shares.share(*p);
-    }
-}
-
-/// Raises each probability to its light's disc floor (the others
-/// unchanged: where they then sum past one, a vertex sometimes samples
-/// two).
-#[inline]
-fn raise_to_floors(p: &mut [f32], floors: &[f32]) {
-    for (p, &floor) in p.iter_mut().zip(floors) {
-        *p = p.max(floor);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::sync::Arc;
 
     use super::super::light_grid::LightGrid;
+    use super::super::per_light::MIN_PROBABILITY;
     use crate::env_map::EnvMap;
     use crate::light::{Environment, Sun};
     use crate::spectrum::luminance;
@@ -473,39 +336,6 @@ mod tests {
         let toward = LightChoice::at(LightSampling::One, &l, &phase, Vec3::Y);
         assert!(probabilities(&away)[0] < 0.1, "{away:?}");
         assert!((probabilities(&toward)[0] - (1.0 - MIN_PROBABILITY)).abs() < 1e-6);
-    }
-
-    /// Shares sum to one, follow the weights where every share is above
-    /// the floor, and lift every light to the floor otherwise, for any
-    /// number of lights; equal where the weights say nothing.
-    #[test]
-    fn shares_keep_every_light_at_its_floor() {
-        let cases: [&[f32]; 6] = [
-            &[1.0, 3.0],
-            &[1e-4, 1.0],
-            &[0.0, 2.0, 5.0],
-            &[1.0; 10],
-            &[0.0, 0.0],
-            &[f32::INFINITY, 1.0],
-        ];
-        for w in cases {
-            let mut p = w.to_vec();
-            into_shares(&mut p);
-            let n = w.len() as f32;
-            let floor = MIN_PROBABILITY.min(0.5 / n);
-            assert!((p.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{w:?}: {p:?}");
-            assert!(p.iter().all(|&p| p >= floor - 1e-7), "{w:?}: {p:?}");
-        }
-        let shares = |w: &[f32]| {
-            let mut p = w.to_vec();
-            into_shares(&mut p);
-            p
-        };
-        assert_eq!(shares(&[1.0, 3.0]), [0.25, 0.75]);
-        let p = shares(&[0.0, 2.0, 6.0]);
-        assert_eq!(p[0], MIN_PROBABILITY);
-        assert!((p[2] / p[1] - 3.0).abs() < 1e-5, "{p:?}");
-        assert_eq!(shares(&[0.0, 0.0]), [0.5, 0.5]);
     }
 
     /// With the floor, a phase-sampled ray escaping into the sun's disc

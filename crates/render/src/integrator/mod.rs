@@ -14,6 +14,7 @@ mod path;
 mod path_light;
 mod path_state;
 mod path_sunward;
+mod per_light;
 mod raymarch;
 mod raymarch2pass;
 mod sunward_mode;
