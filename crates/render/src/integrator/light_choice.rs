@@ -143,23 +143,102 @@ pub(crate) enum LightChoice {
     Pick(PerLight),
 }
 
-impl LightChoice {
+/// The light choice of a render: what it weighs each light by, kept flat
+/// and built once from the lights (as pbrt-v4's light samplers keep
+/// theirs), and the pick at a vertex from it.
+#[derive(Clone, Debug)]
+pub(crate) struct LightSampler {
+    /// `All` or `One`, resolved for the lights.
+    sampling: LightSampling,
+    /// Per light, the luminance of a distant light's irradiance or of a
+    /// dome's mean radiance.
+    luminance: Vec<f32>,
+    /// Per light, the direction toward a distant light's centre (`None`
+    /// for a dome).
+    to_light: Vec<Option<Vec3>>,
+    /// Per light, a distant light's disc's solid angle (0 for a delta
+    /// light or a dome: no floor).
+    disc: Vec<f32>,
+    /// Per light, its weight seen from an isotropic vertex (luminance over
+    /// `4 pi` for a distant light), which [`Self::facing`] gives every
+    /// light but the one it asks about; empty past [`MAX_PICKED_LIGHTS`].
+    isotropic: PerLight,
+}
+
+impl LightSampler {
+    /// The choice `sampling` (resolved here) makes among `lights`.
+    pub fn new(lights: &Lights, sampling: LightSampling) -> Self {
+        let (to_light, disc) = lights
+            .iter()
+            .map(|light| match light {
+                Light::Distant(sun) => (Some(-sun.direction()), sun.solid_angle()),
+                Light::Dome(_) => (None, 0.0),
+            })
+            .unzip();
+        let luminance: Vec<f32> = (0..lights.len()).map(|i| lights.luminance(i)).collect();
+        let mut isotropic = PerLight::zeros(lights.len().min(MAX_PICKED_LIGHTS));
+        for ((w, l), light) in isotropic.iter_mut().zip(&luminance).zip(lights.iter()) {
+            *w = match light {
+                Light::Distant(_) => l * UNIFORM_SPHERE_PDF,
+                Light::Dome(_) => *l,
+            };
+        }
+        Self {
+            sampling: sampling.resolve(lights),
+            luminance,
+            to_light,
+            disc,
+            isotropic,
+        }
+    }
+
+    /// `All` or `One`.
+    #[inline]
+    pub fn sampling(&self) -> LightSampling {
+        self.sampling
+    }
+
+    /// Whether vertices pick among the lights (`one`, and two or more).
+    #[inline]
+    fn picks(&self) -> bool {
+        self.sampling == LightSampling::One && self.luminance.len() >= 2
+    }
+
+    /// Light `i`'s unoccluded in-scattered luminance at a vertex reached
+    /// along `dir_in` (`f E` toward a distant light's centre, a dome's mean
+    /// radiance: the phase function integrates to 1 over the sphere), and
+    /// the least probability its disc needs ([`disc_floor`]; 0 for other
+    /// lights).
+    #[inline(always)]
+    fn weigh(&self, i: usize, phase: &Phase, dir_in: Vec3) -> (f32, f32) {
+        match self.to_light[i] {
+            Some(to_light) => {
+                let f = phase.eval(dir_in, to_light);
+                let disc = self.disc[i];
+                let floor = if disc > 0.0 { disc_floor(f, disc) } else { 0.0 };
+                (self.luminance[i] * f, floor)
+            }
+            None => (self.luminance[i], 0.0),
+        }
+    }
+
     /// The pick at a vertex reached along `dir_in` with phase function
     /// `phase`, each light weighed by its unoccluded in-scattered light:
-    /// [`Self::All`] unless `sampling` is `one` (resolved, see
-    /// [`LightSampling::resolve`]) and there are lights to choose among.
-    pub fn at(sampling: LightSampling, lights: &Lights, phase: &Phase, dir_in: Vec3) -> Self {
-        if sampling != LightSampling::One || lights.len() < 2 {
-            return Self::All;
+    /// [`LightChoice::All`] unless the sampling is `one` and there are
+    /// lights to choose among.
+    #[inline]
+    pub fn at(&self, phase: &Phase, dir_in: Vec3) -> LightChoice {
+        if !self.picks() {
+            return LightChoice::All;
         }
-        let mut p = PerLight::zeros(lights.len());
+        let mut p = PerLight::zeros(self.luminance.len());
         let mut floors = p;
         for (i, (p, floor)) in p.iter_mut().zip(floors.iter_mut()).enumerate() {
-            (*p, *floor) = weigh(lights, i, phase, dir_in);
+            (*p, *floor) = self.weigh(i, phase, dir_in);
         }
         into_shares(&mut p);
         raise_to_floors(&mut p, &floors);
-        Self::Pick(p)
+        LightChoice::Pick(p)
     }
 
     /// The probability that a vertex whose phase function toward distant
@@ -167,24 +246,20 @@ impl LightChoice {
     /// others weighed as from an isotropic vertex (an estimate, for
     /// sunward scattering's keep probability, which only needs to be the
     /// same for both of its strategies).
-    pub fn facing(sampling: LightSampling, lights: &Lights, light: usize, f: f32) -> f32 {
-        if sampling != LightSampling::One || lights.len() < 2 {
+    #[inline]
+    pub fn facing(&self, light: usize, f: f32) -> f32 {
+        if !self.picks() {
             return 1.0;
         }
-        let weight = |i: usize| {
-            lights.luminance(i)
-                * match lights.get(i) {
-                    Light::Distant(_) if i == light => f,
-                    Light::Distant(_) => UNIFORM_SPHERE_PDF,
-                    Light::Dome(_) => 1.0,
-                }
-        };
-        let share = Shares::of((0..lights.len()).map(weight)).share(weight(light));
-        let floor = match lights.get(light) {
-            Light::Distant(sun) => disc_floor(f, sun.solid_angle()),
-            Light::Dome(_) => 0.0,
-        };
-        share.max(floor)
+        let mut w = self.isotropic;
+        w[light] = self.luminance[light] * f;
+        let share = Shares::of(w.iter().copied()).share(w[light]);
+        let disc = self.disc[light];
+        if disc > 0.0 {
+            share.max(disc_floor(f, disc))
+        } else {
+            share
+        }
     }
 
     /// The pick at a vertex reached along `dir_in` with phase function
@@ -193,10 +268,11 @@ impl LightChoice {
     /// the lights weighed by what they bring through the media, and no
     /// light at all, with the remaining probability, where the vertex sees
     /// less than [`TRACE_FRACTION`] of its unoccluded light.
-    pub fn shadowed(lights: &Lights, seen: &[f32], phase: &Phase, dir_in: Vec3) -> Self {
+    #[inline]
+    pub fn shadowed(&self, seen: &[f32], phase: &Phase, dir_in: Vec3) -> LightChoice {
         // Each light's unoccluded light, then (in place) what it brings
         // through the media.
-        let mut p = PerLight::zeros(lights.len());
+        let mut p = PerLight::zeros(self.luminance.len());
         let mut floors = p;
         let (mut open_total, mut seen_total) = (0.0f32, 0.0f32);
         for (i, ((&seen, p), floor)) in seen
@@ -206,7 +282,7 @@ impl LightChoice {
             .enumerate()
         {
             let open;
-            (open, *floor) = weigh(lights, i, phase, dir_in);
+            (open, *floor) = self.weigh(i, phase, dir_in);
             open_total += open;
             seen_total += open * seen;
             *p = open;
@@ -230,9 +306,11 @@ impl LightChoice {
         for (p, &floor) in p.iter_mut().zip(floors.iter()) {
             *p = (trace * shares.share(*p)).max(floor);
         }
-        Self::Pick(p)
+        LightChoice::Pick(p)
     }
+}
 
+impl LightChoice {
     /// The probability that light `i` is sampled.
     #[inline]
     pub fn probability(&self, i: usize) -> f32 {
@@ -255,26 +333,6 @@ impl LightChoice {
             start = if e >= 1.0 { e - 1.0 } else { e };
             ((u >= s && u < e) || u < e - 1.0).then_some(i)
         })
-    }
-}
-
-/// A light's unoccluded in-scattered luminance at a vertex reached along
-/// `dir_in` (`f E` toward a distant light's centre, a dome's mean radiance:
-/// the phase function integrates to 1 over the sphere), and the least
-/// probability its disc needs ([`disc_floor`]; 0 for other lights).
-#[inline(always)]
-fn weigh(lights: &Lights, i: usize, phase: &Phase, dir_in: Vec3) -> (f32, f32) {
-    match lights.get(i) {
-        Light::Distant(sun) => {
-            let f = phase.eval(dir_in, -sun.direction());
-            let floor = if sun.is_delta() {
-                0.0
-            } else {
-                disc_floor(f, sun.solid_angle())
-            };
-            (lights.luminance(i) * f, floor)
-        }
-        Light::Dome(_) => (lights.luminance(i), 0.0),
     }
 }
 
@@ -321,19 +379,19 @@ mod tests {
             (Vec3::X, "side"),
             (Vec3::new(0.3, 0.5, -0.2).normalize(), "oblique"),
         ] {
-            let c = LightChoice::at(LightSampling::One, &l, &phase, dir_in);
+            let c = LightSampler::new(&l, LightSampling::One).at(&phase, dir_in);
             let p = probabilities(&c);
             assert!((p[0] - expected(dir_in)).abs() < 1e-6, "{label}: {c:?}");
             assert!((p[0] + p[1] - 1.0).abs() < 1e-6, "{label}: {c:?}");
             let facing =
-                LightChoice::facing(LightSampling::One, &l, 0, phase.eval(dir_in, Vec3::Y));
+                LightSampler::new(&l, LightSampling::One).facing(0, phase.eval(dir_in, Vec3::Y));
             assert!(
                 (facing - p[0]).abs() < 1e-6,
                 "{label}: {facing} against {c:?}"
             );
         }
-        let away = LightChoice::at(LightSampling::One, &l, &phase, Vec3::NEG_Y);
-        let toward = LightChoice::at(LightSampling::One, &l, &phase, Vec3::Y);
+        let away = LightSampler::new(&l, LightSampling::One).at(&phase, Vec3::NEG_Y);
+        let toward = LightSampler::new(&l, LightSampling::One).at(&phase, Vec3::Y);
         assert!(probabilities(&away)[0] < 0.1, "{away:?}");
         assert!((probabilities(&toward)[0] - (1.0 - MIN_PROBABILITY)).abs() < 1e-6);
     }
@@ -404,7 +462,7 @@ mod tests {
         let phase = Phase::hg(0.3);
         let l = lights();
         assert_eq!(
-            LightChoice::at(LightSampling::All, &l, &phase, Vec3::X),
+            LightSampler::new(&l, LightSampling::All).at(&phase, Vec3::X),
             LightChoice::All
         );
         assert_eq!(LightSampling::Auto.resolve(&l), LightSampling::One);
@@ -416,7 +474,7 @@ mod tests {
         let sun_only = Lights::sun_and_sky(Some(sun), None);
         assert_eq!(LightSampling::Auto.resolve(&sun_only), LightSampling::All);
         assert_eq!(
-            LightChoice::at(LightSampling::One, &sun_only, &phase, Vec3::X),
+            LightSampler::new(&sun_only, LightSampling::One).at(&phase, Vec3::X),
             LightChoice::All
         );
     }
@@ -441,7 +499,8 @@ mod tests {
         let phase = Phase::hg(0.5);
         let dir_in = Vec3::new(0.3, 0.5, -0.2).normalize();
         let shadowed = |l: &Lights, grid: &LightGrid, p: Vec3| {
-            let c = LightChoice::shadowed(l, &grid.seen(&phase, p, dir_in), &phase, dir_in);
+            let sampler = LightSampler::new(l, LightSampling::One);
+            let c = sampler.shadowed(&grid.seen(&phase, p, dir_in), &phase, dir_in);
             probabilities(&c).to_vec()
         };
         let deep = shadowed(&l, &grid, Vec3::splat(2.0));
@@ -459,7 +518,7 @@ mod tests {
         assert!((lit[0] - share).abs() < 1e-5, "{lit:?} against {share}");
         // The unoccluded pick does not see the cube, so it weighs the two
         // lights otherwise.
-        let open = LightChoice::at(LightSampling::One, &l, &phase, dir_in);
+        let open = LightSampler::new(&l, LightSampling::One).at(&phase, dir_in);
         assert!(lit[0] != probabilities(&open)[0], "{lit:?} {open:?}");
         let sky_only = Lights::sun_and_sky(None, Some(Environment::new(Vec3::splat(0.2))));
         let grid = cube_grid(&sky_only);

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::light_choice::{LightChoice, LightSampling, PerLight};
+use super::light_choice::{LightChoice, LightSampler, LightSampling, PerLight};
 use super::light_grid::LightGrid;
 use super::path_state::{Arrival, At, Escape, Path, Vertex};
 use super::sunward_mode::Sunward;
@@ -89,7 +89,8 @@ pub struct PathTracer<'a, M> {
     /// Tag contributions with their light groups (off: `Sample::groups`
     /// stays zero and costs nothing).
     light_groups: bool,
-    pub(super) light_sampling: LightSampling,
+    /// Which lights each vertex samples ([`LightSampling`]).
+    pub(super) sampler: LightSampler,
     /// Where the next vertex's sunlight is gathered by sunward scattering
     /// as well ([`Sunward`]).
     pub(super) sunward: Sunward,
@@ -119,7 +120,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         Self {
             medium,
             sunward_light,
-            light_sampling: LightSampling::default().resolve(&lights),
+            sampler: LightSampler::new(&lights, LightSampling::default()),
             lights,
             estimator,
             max_depth,
@@ -142,7 +143,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     /// How many lights each vertex samples, `auto` resolved for this
     /// tracer's lights.
     pub fn light_sampling(&self) -> LightSampling {
-        self.light_sampling
+        self.sampler.sampling()
     }
 
     /// What the vertex at `p`, reached along `dir_in`, sees of each light
@@ -162,10 +163,10 @@ impl<'a, M: Media> PathTracer<'a, M> {
         seen: Option<&PerLight>,
     ) -> LightChoice {
         match seen {
-            Some(seen) if self.light_sampling == LightSampling::One => {
-                LightChoice::shadowed(&self.lights, seen, phase, dir_in)
+            Some(seen) if self.sampler.sampling() == LightSampling::One => {
+                self.sampler.shadowed(seen, phase, dir_in)
             }
-            _ => LightChoice::at(self.light_sampling, &self.lights, phase, dir_in),
+            _ => self.sampler.at(phase, dir_in),
         }
     }
 
@@ -180,7 +181,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     /// Samples every light at each vertex, or one ([`LightSampling`]).
     pub fn with_light_sampling(self, light_sampling: LightSampling) -> Self {
         Self {
-            light_sampling: light_sampling.resolve(&self.lights),
+            sampler: LightSampler::new(&self.lights, light_sampling),
             ..self
         }
     }

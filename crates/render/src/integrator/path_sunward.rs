@@ -42,7 +42,7 @@
 
 use glam::Vec3;
 
-use super::light_choice::{LightChoice, PerLight};
+use super::light_choice::PerLight;
 use super::path::PathTracer;
 use super::path_state::{At, Path};
 use crate::medium::Media;
@@ -131,7 +131,7 @@ impl<M: Media> PathTracer<'_, M> {
     /// strategies).
     #[inline]
     fn sun_pick(&self, light: usize, f_sun: f32) -> f32 {
-        LightChoice::facing(self.light_sampling, &self.lights, light, f_sun)
+        self.sampler.facing(light, f_sun)
     }
 
     /// [`keep_probability`] with the sun's pick at the next vertex
@@ -227,6 +227,7 @@ impl<M: Media> PathTracer<'_, M> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::light_choice::LightSampler;
     use crate::integrator::path_state::Arrival;
     use crate::integrator::LightSampling;
     use crate::light::{Environment, Lights, Sun};
@@ -289,7 +290,8 @@ mod tests {
             Some(Sun::new(Vec3::new(0.0, -1.0, 0.0), Vec3::splat(2.0), 0.0)),
             Some(Environment::new(Vec3::splat(0.3))),
         );
-        let one = |f_sun: f32| LightChoice::facing(LightSampling::One, &lights, 0, f_sun);
+        let sampler = LightSampler::new(&lights, LightSampling::One);
+        let one = |f_sun: f32| sampler.facing(0, f_sun);
         let all = |_: f32| 1.0f32;
         let s = Vec3::Y;
         let n = 400_000;
