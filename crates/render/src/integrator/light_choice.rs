@@ -48,7 +48,7 @@
 
 use glam::Vec3;
 
-use super::per_light::{into_shares, raise_to_floors, Shares};
+use super::per_light::{into_shares, into_shares_of, raise_to_floors, Shares};
 pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
 use crate::light::{Light, Lights};
 use crate::phase::Phase;
@@ -302,9 +302,9 @@ impl LightSampler {
         } else {
             open_total
         };
-        let shares = Shares::with_total(p.iter().copied(), p.len() as u32, total);
+        into_shares_of(&mut p, total);
         for (p, &floor) in p.iter_mut().zip(floors.iter()) {
-            *p = (trace * shares.share(*p)).max(floor);
+            *p = (trace * *p).max(floor);
         }
         LightChoice::Pick(p)
     }

@@ -79,11 +79,7 @@ impl Shares {
     /// [`Self::of`] `n` weights known to sum to `total`.
     #[inline]
     pub(super) fn with_total(weights: impl Iterator<Item = f32>, n: u32, total: f32) -> Self {
-        let floor = if n < 2 {
-            0.0
-        } else {
-            MIN_PROBABILITY.min(0.5 / n as f32)
-        };
+        let floor = defensive_floor(n);
         let mut shares = Self {
             total,
             floor,
@@ -129,9 +125,45 @@ impl Shares {
 /// Turns weights into their [`Shares`].
 #[inline]
 pub(super) fn into_shares(p: &mut [f32]) {
-    let shares = Shares::of(p.iter().copied());
+    let total = p.iter().sum();
+    into_shares_of(p, total);
+}
+
+/// Turns weights known to sum to `total` into their [`Shares`], in
+/// place: what [`Shares::share`] gives each, with one division per weight
+/// (this runs at every path vertex).
+#[inline]
+pub(super) fn into_shares_of(p: &mut [f32], total: f32) {
+    let n = p.len();
+    if !(total > 0.0 && total.is_finite()) {
+        p.iter_mut().for_each(|p| *p = 1.0 / n as f32);
+        return;
+    }
+    let floor = defensive_floor(n as u32);
+    let (mut low, mut high) = (0u32, 0.0f32);
     for p in p.iter_mut() {
-        *p = shares.share(*p);
+        *p /= total;
+        if *p < floor {
+            low += 1;
+        } else {
+            high += *p;
+        }
+    }
+    if low > 0 {
+        let scale = (1.0 - floor * low as f32) / high;
+        for p in p.iter_mut() {
+            *p = if *p < floor { floor } else { *p * scale };
+        }
+    }
+}
+
+/// The least share among `n` lights.
+#[inline]
+fn defensive_floor(n: u32) -> f32 {
+    if n < 2 {
+        0.0
+    } else {
+        MIN_PROBABILITY.min(0.5 / n as f32)
     }
 }
 
