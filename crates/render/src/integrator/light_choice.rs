@@ -479,6 +479,36 @@ mod tests {
         );
     }
 
+    /// Up to [`MAX_PICKED_LIGHTS`] lights a vertex picks among them, every
+    /// one with at least its defensive share; past that it samples every
+    /// light.
+    #[test]
+    fn a_pick_covers_up_to_its_most_lights_and_then_every_light_is_sampled() {
+        let phase = Phase::hg(0.6);
+        let sun = |i: usize| {
+            let a = i as f32;
+            Light::from(Sun::new(
+                Vec3::new(a.cos(), -1.0, a.sin()),
+                Vec3::splat(1.0 + a),
+                0.0,
+            ))
+        };
+        let sky = || Light::from(Environment::new(Vec3::splat(0.2)));
+        let most = Lights::new((0..MAX_PICKED_LIGHTS - 1).map(sun).chain([sky()]));
+        assert_eq!(LightSampling::Auto.resolve(&most), LightSampling::One);
+        let c = LightSampler::new(&most, LightSampling::Auto).at(&phase, Vec3::X);
+        let p = probabilities(&c);
+        assert_eq!(p.len(), MAX_PICKED_LIGHTS);
+        let floor = MIN_PROBABILITY.min(0.5 / MAX_PICKED_LIGHTS as f32);
+        assert!((p.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{p:?}");
+        assert!(p.iter().all(|&p| p >= floor * 0.9999), "{p:?}");
+        let too_many = Lights::new((0..MAX_PICKED_LIGHTS).map(sun).chain([sky()]));
+        assert_eq!(LightSampling::One.resolve(&too_many), LightSampling::All);
+        let sampler = LightSampler::new(&too_many, LightSampling::One);
+        assert_eq!(sampler.at(&phase, Vec3::X), LightChoice::All);
+        assert_eq!(sampler.facing(0, 1.0), 1.0);
+    }
+
     /// A cube of uniform density 4 over [0, 4]^3 (optical depth 16 across),
     /// its shadow grid under `lights`.
     fn cube_grid(lights: &Lights) -> LightGrid {
