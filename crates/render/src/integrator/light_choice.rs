@@ -48,7 +48,7 @@
 
 use glam::Vec3;
 
-use super::per_light::{into_shares, into_shares_of, raise_to_floors, Shares};
+use super::per_light::{into_shares, lane_shares, lanes_of, raise_to_floors, Lanes, Shares};
 pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
 use crate::light::{Light, Lights};
 use crate::phase::Phase;
@@ -159,6 +159,8 @@ pub(crate) struct LightSampler {
     /// Per light, a distant light's disc's solid angle (0 for a delta
     /// light or a dome: no floor).
     disc: Vec<f32>,
+    /// 1 in the lanes of the lights, 0 past them ([`lane_shares`]).
+    lanes: Lanes,
     /// Per light, its weight seen from an isotropic vertex (luminance over
     /// `4 pi` for a distant light), which [`Self::facing`] gives every
     /// light but the one it asks about; empty past [`MAX_PICKED_LIGHTS`].
@@ -189,6 +191,7 @@ impl LightSampler {
             to_light,
             disc,
             isotropic,
+            lanes: lanes_of(lights.len()),
         }
     }
 
@@ -269,24 +272,19 @@ impl LightSampler {
     /// light at all, with the remaining probability, where the vertex sees
     /// less than [`TRACE_FRACTION`] of its unoccluded light.
     #[inline]
-    pub fn shadowed(&self, seen: &[f32], phase: &Phase, dir_in: Vec3) -> LightChoice {
-        // Each light's unoccluded light, then (in place) what it brings
-        // through the media.
-        let mut p = PerLight::zeros(self.luminance.len());
-        let mut floors = p;
-        let (mut open_total, mut seen_total) = (0.0f32, 0.0f32);
-        for (i, ((&seen, p), floor)) in seen
-            .iter()
-            .zip(p.iter_mut())
-            .zip(floors.iter_mut())
-            .enumerate()
-        {
-            let open;
-            (open, *floor) = self.weigh(i, phase, dir_in);
-            open_total += open;
-            seen_total += open * seen;
-            *p = open;
+    pub fn shadowed(&self, seen: &PerLight, phase: &Phase, dir_in: Vec3) -> LightChoice {
+        // Each light's unoccluded light and its disc's floor, then, over
+        // the lanes (this runs at every vertex), what each brings through
+        // the media and its share.
+        let n = self.luminance.len();
+        let (mut open, mut floors) = (PerLight::zeros(n), PerLight::zeros(n));
+        for (i, (open, floor)) in open.iter_mut().zip(floors.iter_mut()).enumerate() {
+            (*open, *floor) = self.weigh(i, phase, dir_in);
         }
+        let (open, seen) = (open.lanes(), seen.lanes());
+        let through = [open[0] * seen[0], open[1] * seen[1]];
+        let open_total = open[0].element_sum() + open[1].element_sum();
+        let seen_total = through[0].element_sum() + through[1].element_sum();
         let trace = seen_total / (TRACE_FRACTION * open_total);
         let trace = if trace.is_finite() {
             trace.clamp(MIN_TRACE, 1.0)
@@ -294,19 +292,15 @@ impl LightSampler {
             1.0
         };
         // Where the grid sees no light at all, the unoccluded weights.
-        let total = if seen_total > 0.0 {
-            for (p, &seen) in p.iter_mut().zip(seen) {
-                *p *= seen;
-            }
-            seen_total
+        let (w, total) = if seen_total > 0.0 {
+            (through, seen_total)
         } else {
-            open_total
+            (open, open_total)
         };
-        into_shares_of(&mut p, total);
-        for (p, &floor) in p.iter_mut().zip(floors.iter()) {
-            *p = (trace * *p).max(floor);
-        }
-        LightChoice::Pick(p)
+        let p = lane_shares(w, total, n, self.lanes);
+        let floors = floors.lanes();
+        let p = [0, 1].map(|k| (p[k] * trace).max(floors[k]));
+        LightChoice::Pick(PerLight::from_lanes(p, n))
     }
 }
 

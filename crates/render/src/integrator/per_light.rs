@@ -2,6 +2,8 @@
 //! fixed array, and the defensive shares the pick's weights are made
 //! into (`light_choice.rs` decides what the weights are).
 
+use glam::Vec4;
+
 /// A pick probability is at least this (among two lights; among `n`, at
 /// least `min(MIN_PROBABILITY, 1 / 2n)`).
 pub const MIN_PROBABILITY: f32 = 0.05;
@@ -26,6 +28,25 @@ pub(crate) struct PerLight {
 }
 
 impl PerLight {
+    /// The values as two four-lane vectors, the lanes past the lights'
+    /// zero.
+    #[inline]
+    pub fn lanes(&self) -> Lanes {
+        [
+            Vec4::from_slice(&self.values[..4]),
+            Vec4::from_slice(&self.values[4..]),
+        ]
+    }
+
+    /// The values of `lanes` for `n` lights.
+    #[inline]
+    pub fn from_lanes(lanes: Lanes, n: usize) -> Self {
+        let mut p = Self::zeros(n);
+        lanes[0].write_to_slice(&mut p.values[..4]);
+        lanes[1].write_to_slice(&mut p.values[4..]);
+        p
+    }
+
     /// `n` zeros (`n` at most [`MAX_PICKED_LIGHTS`]).
     #[inline]
     pub fn zeros(n: usize) -> Self {
@@ -52,10 +73,22 @@ impl std::ops::DerefMut for PerLight {
     }
 }
 
-/// Weights' shares of their sum, every share at least the defensive floor
-/// `min(MIN_PROBABILITY, 1 / (2 n))` (those above it scaled down to make
-/// room), so that no light is starved where the weights are wrong; equal
-/// shares where the weights sum to nothing or overflow.
+/// Turns weights into their shares of the sum, every share at least the
+/// defensive floor `min(MIN_PROBABILITY, 1 / (2 n))` (those above it
+/// scaled down to make room), so that no light is starved where the
+/// weights are wrong; equal shares where the weights sum to nothing or
+/// overflow.
+#[inline]
+pub(super) fn into_shares(p: &mut PerLight) {
+    let (n, w) = (p.len(), p.lanes());
+    let total = w[0].element_sum() + w[1].element_sum();
+    *p = PerLight::from_lanes(lane_shares(w, total, n, lanes_of(n)), n);
+}
+
+/// [`into_shares`]'s rule one weight at a time: the share of one light,
+/// for sunward scattering's keep probability, which asks for one light's
+/// and would otherwise write a weight into an array only to read it back
+/// as lanes (a wait on the store at every call).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Shares {
     total: f32,
@@ -122,39 +155,38 @@ impl Shares {
     }
 }
 
-/// Turns weights into their [`Shares`].
-#[inline]
-pub(super) fn into_shares(p: &mut [f32]) {
-    let total = p.iter().sum();
-    into_shares_of(p, total);
-}
+/// A [`PerLight`]'s values as two four-lane vectors.
+pub(super) type Lanes = [Vec4; 2];
 
-/// Turns weights known to sum to `total` into their [`Shares`], in
-/// place: what [`Shares::share`] gives each, with one division per weight
+/// [`into_shares`] of weights `w` summing to `total`, for `n` lights whose
+/// lanes [`lanes_of`] marks; over the lanes, with no loop over the lights
 /// (this runs at every path vertex).
 #[inline]
-pub(super) fn into_shares_of(p: &mut [f32], total: f32) {
-    let n = p.len();
+pub(super) fn lane_shares(w: Lanes, total: f32, n: usize, lights: Lanes) -> Lanes {
     if !(total > 0.0 && total.is_finite()) {
-        p.iter_mut().for_each(|p| *p = 1.0 / n as f32);
-        return;
+        let equal = 1.0 / n as f32;
+        return lights.map(|l| l * equal);
     }
     let floor = defensive_floor(n as u32);
-    let (mut low, mut high) = (0u32, 0.0f32);
-    for p in p.iter_mut() {
-        *p /= total;
-        if *p < floor {
-            low += 1;
-        } else {
-            high += *p;
-        }
+    let p = w.map(|w| w / total);
+    // The lanes past the lights hold 0 and are never below their floor 0.
+    let low = [0, 1].map(|k| p[k].cmplt(lights[k] * floor));
+    let count = low[0].bitmask().count_ones() + low[1].bitmask().count_ones();
+    if count == 0 {
+        return p;
     }
-    if low > 0 {
-        let scale = (1.0 - floor * low as f32) / high;
-        for p in p.iter_mut() {
-            *p = if *p < floor { floor } else { *p * scale };
-        }
-    }
+    let high: f32 = (0..2)
+        .map(|k| Vec4::select(low[k], Vec4::ZERO, p[k]).element_sum())
+        .sum();
+    let scale = (1.0 - floor * count as f32) / high;
+    [0, 1].map(|k| Vec4::select(low[k], Vec4::splat(floor), p[k] * scale))
+}
+
+/// 1 in the lanes of `n` lights, 0 past them.
+pub(super) fn lanes_of(n: usize) -> Lanes {
+    let mut ones = PerLight::zeros(n.min(MAX_PICKED_LIGHTS));
+    ones.iter_mut().for_each(|x| *x = 1.0);
+    ones.lanes()
 }
 
 /// The least share among `n` lights.
@@ -181,32 +213,52 @@ pub(super) fn raise_to_floors(p: &mut [f32], floors: &[f32]) {
 mod tests {
     use super::*;
 
+    fn shares(w: &[f32]) -> Vec<f32> {
+        let mut p = PerLight::zeros(w.len());
+        p.copy_from_slice(w);
+        into_shares(&mut p);
+        p.to_vec()
+    }
+
+    /// The one-weight rule gives what the lanes give.
+    #[test]
+    fn one_share_is_the_lanes_share() {
+        for w in [
+            &[1.0f32, 3.0][..],
+            &[1e-4, 1.0],
+            &[0.0, 2.0, 5.0],
+            &[1e-6, 1.0, 2.0, 0.0, 3.0, 1e-3, 4.0, 0.5],
+            &[0.0, 0.0],
+        ] {
+            let all = shares(w);
+            let one = Shares::of(w.iter().copied());
+            for (i, &p) in all.iter().enumerate() {
+                assert!((one.share(w[i]) - p).abs() <= 1e-7, "{w:?}: light {i}");
+            }
+        }
+    }
+
     /// Shares sum to one, follow the weights where every share is above
     /// the floor, and lift every light to the floor otherwise, for any
     /// number of lights; equal where the weights say nothing.
     #[test]
     fn shares_keep_every_light_at_its_floor() {
-        let cases: [&[f32]; 6] = [
+        let cases: [&[f32]; 7] = [
             &[1.0, 3.0],
             &[1e-4, 1.0],
             &[0.0, 2.0, 5.0],
-            &[1.0; 10],
+            &[1.0; MAX_PICKED_LIGHTS],
+            &[1e-6, 1.0, 2.0, 0.0, 3.0, 1e-3, 4.0, 0.5],
             &[0.0, 0.0],
             &[f32::INFINITY, 1.0],
         ];
         for w in cases {
-            let mut p = w.to_vec();
-            into_shares(&mut p);
+            let p = shares(w);
             let n = w.len() as f32;
             let floor = MIN_PROBABILITY.min(0.5 / n);
             assert!((p.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{w:?}: {p:?}");
             assert!(p.iter().all(|&p| p >= floor - 1e-7), "{w:?}: {p:?}");
         }
-        let shares = |w: &[f32]| {
-            let mut p = w.to_vec();
-            into_shares(&mut p);
-            p
-        };
         assert_eq!(shares(&[1.0, 3.0]), [0.25, 0.75]);
         let p = shares(&[0.0, 2.0, 6.0]);
         assert_eq!(p[0], MIN_PROBABILITY);
