@@ -89,7 +89,7 @@ pub struct LightGrid {
 impl LightGrid {
     /// Pass one: marches shadow rays from every lattice point of the
     /// non-empty bricks (in parallel; each point has its own random stream,
-    /// so the grid is the same for any thread count). A sun with a disc is
+    /// so the grid is the same for any thread count). A distant light with a disc is
     /// treated as a point at its centre here.
     pub fn build<M: Media>(
         medium: &M,
@@ -190,7 +190,7 @@ impl LightGrid {
     }
 
     /// Number of bricks holding light (for reporting sparsity); each
-    /// costs 8^3 entries of 4 bytes per value (20 for a sun and a sky).
+    /// costs 8^3 entries of 16 bytes per light.
     pub fn stored_bricks(&self) -> usize {
         self.brick_data.iter().filter(|b| b.is_some()).count()
     }
