@@ -99,11 +99,13 @@ declare_settings! {
     /// one light picked by its in-scattered light there seen through the
     /// media (a coarse shadow grid; half the shadow rays under a sun and a
     /// sky, and few deep in a thick cloud), or to every light; `auto` picks
-    /// one under a constant sky, every light under a map.
+    /// one under constant domes (a constant sky), every light under a map;
+    /// a scene of more than 8 lights samples every light.
     light_sampling: LightSampling, flag(long, value_enum), default(LightSampling::default()),
         example(LightSampling::All);
     /// Sunward scattering: at each scattering vertex, also scatter toward
-    /// the sun and gather its light at the next vertex, weighed against
+    /// the sun (the brightest distant light) and gather its light at the
+    /// next vertex, weighed against
     /// the path's own next vertex (unbiased; about twice the shadow rays
     /// of the vertices it runs at, for much less noise under a
     /// forward-scattering phase function); `auto` runs it where the phase
