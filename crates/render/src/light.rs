@@ -280,9 +280,6 @@ pub struct Lights {
     list: Vec<Light>,
     groups: Vec<u8>,
     emission_group: u8,
-    /// Each light's [`Light::luminance`], which light choices weigh at
-    /// every vertex.
-    luminance: Vec<f32>,
 }
 
 impl Default for Lights {
@@ -310,16 +307,10 @@ impl Lights {
                 LightKind::Dome => DEFAULT_GROUP_DOME,
             })
             .collect();
-        Self::from_parts(list, groups, DEFAULT_GROUP_EMISSION)
-    }
-
-    fn from_parts(list: Vec<Light>, groups: Vec<u8>, emission_group: u8) -> Self {
-        let luminance = list.iter().map(Light::luminance).collect();
         Self {
             list,
             groups,
-            emission_group,
-            luminance,
+            emission_group: DEFAULT_GROUP_EMISSION,
         }
     }
 
@@ -347,12 +338,6 @@ impl Lights {
     #[inline]
     pub fn get(&self, i: usize) -> &Light {
         &self.list[i]
-    }
-
-    /// [`Light::luminance`] of light `i`.
-    #[inline]
-    pub fn luminance(&self, i: usize) -> f32 {
-        self.luminance[i]
     }
 
     /// The light group light `i` is tagged with.
@@ -392,6 +377,10 @@ impl Lights {
             .zip(self.groups)
             .filter(|(l, _)| !l.is_black())
             .unzip();
-        Self::from_parts(list, groups, self.emission_group)
+        Self {
+            list,
+            groups,
+            emission_group: self.emission_group,
+        }
     }
 }

@@ -177,7 +177,7 @@ impl LightSampler {
                 Light::Dome(_) => (None, 0.0),
             })
             .unzip();
-        let luminance: Vec<f32> = (0..lights.len()).map(|i| lights.luminance(i)).collect();
+        let luminance: Vec<f32> = lights.iter().map(Light::luminance).collect();
         let mut isotropic = PerLight::zeros(lights.len().min(MAX_PICKED_LIGHTS));
         for ((w, l), light) in isotropic.iter_mut().zip(&luminance).zip(lights.iter()) {
             *w = match light {
@@ -225,6 +225,17 @@ impl LightSampler {
         }
     }
 
+    /// [`Self::weigh`] of every light, the weights and the floors apart.
+    #[inline(always)]
+    fn weigh_all(&self, phase: &Phase, dir_in: Vec3) -> (PerLight, PerLight) {
+        let n = self.luminance.len();
+        let (mut open, mut floors) = (PerLight::zeros(n), PerLight::zeros(n));
+        for (i, (open, floor)) in open.iter_mut().zip(floors.iter_mut()).enumerate() {
+            (*open, *floor) = self.weigh(i, phase, dir_in);
+        }
+        (open, floors)
+    }
+
     /// The pick at a vertex reached along `dir_in` with phase function
     /// `phase`, each light weighed by its unoccluded in-scattered light:
     /// [`LightChoice::All`] unless the sampling is `one` and there are
@@ -234,11 +245,7 @@ impl LightSampler {
         if !self.picks() {
             return LightChoice::All;
         }
-        let mut p = PerLight::zeros(self.luminance.len());
-        let mut floors = p;
-        for (i, (p, floor)) in p.iter_mut().zip(floors.iter_mut()).enumerate() {
-            (*p, *floor) = self.weigh(i, phase, dir_in);
-        }
+        let (mut p, floors) = self.weigh_all(phase, dir_in);
         into_shares(&mut p);
         raise_to_floors(&mut p, &floors);
         LightChoice::Pick(p)
@@ -277,10 +284,7 @@ impl LightSampler {
         // the lanes (this runs at every vertex), what each brings through
         // the media and its share.
         let n = self.luminance.len();
-        let (mut open, mut floors) = (PerLight::zeros(n), PerLight::zeros(n));
-        for (i, (open, floor)) in open.iter_mut().zip(floors.iter_mut()).enumerate() {
-            (*open, *floor) = self.weigh(i, phase, dir_in);
-        }
+        let (open, floors) = self.weigh_all(phase, dir_in);
         let (open, seen) = (open.lanes(), seen.lanes());
         let through = [open[0] * seen[0], open[1] * seen[1]];
         let open_total = open[0].element_sum() + open[1].element_sum();

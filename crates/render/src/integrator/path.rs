@@ -109,13 +109,11 @@ impl<'a, M: Media> PathTracer<'a, M> {
         max_depth: Option<u32>,
     ) -> Self {
         let lights = lights.pruned();
+        // The first of the brightest, where several are alike.
         let sunward_light = lights
             .distant()
             .map(|(i, sun)| (i, luminance(sun.irradiance())))
-            .fold(None, |best: Option<(usize, f32)>, (i, e)| match best {
-                Some((_, b)) if b >= e => best,
-                _ => Some((i, e)),
-            })
+            .reduce(|best, next| if next.1 > best.1 { next } else { best })
             .map(|(i, _)| i);
         Self {
             medium,
