@@ -245,15 +245,6 @@ impl Light {
         }
     }
 
-    /// A direction toward the light from two uniform numbers.
-    #[inline]
-    pub fn sample(&self, u1: f32, u2: f32) -> LightSample {
-        match self {
-            Self::Distant(sun) => sun.sample(u1, u2),
-            Self::Dome(env) => env.sample(u1, u2),
-        }
-    }
-
     /// Radiance reaching a ray that escapes along `dir` and the density
     /// with which [`sample`](Self::sample) would have drawn `dir`; `None`
     /// where the light is not seen that way (outside a disc, or a delta

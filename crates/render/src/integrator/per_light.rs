@@ -106,12 +106,6 @@ impl Shares {
         let (n, total) = weights
             .clone()
             .fold((0u32, 0.0f32), |(n, t), w| (n + 1, t + w));
-        Self::with_total(weights, n, total)
-    }
-
-    /// [`Self::of`] `n` weights known to sum to `total`.
-    #[inline]
-    pub(super) fn with_total(weights: impl Iterator<Item = f32>, n: u32, total: f32) -> Self {
         let floor = defensive_floor(n);
         let mut shares = Self {
             total,
