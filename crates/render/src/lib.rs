@@ -88,7 +88,7 @@ pub use integrator::{
     AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, LightSampling,
     PathTracer, RayMarcher, Sample, Sunward, TwoPassMarcher,
 };
-pub use light::{Environment, Light, LightKind, Lights, Sun};
+pub use light::{Environment, Light, LightKind, Lights, SphereLight, Spot, Sun};
 pub use medium::{
     Bounds3, BrickField, DensityField, Emission, Extinction, GlobalMedia, Interaction,
     MajorantSegment, Media, Medium, MediumError, Velocity, VelocityUnit,

@@ -37,8 +37,10 @@ pub struct Counters {
     /// Next-event shadow rays toward distant lights (sunward scattering's
     /// included)...
     pub nee_rays_distant: u64,
-    /// ...and toward domes.
+    /// ...toward domes...
     pub nee_rays_dome: u64,
+    /// ...and toward sphere, point and spot lights.
+    pub nee_rays_sphere: u64,
     /// Times a dome was consulted: directions sampled from it for
     /// next-event estimation, and escaped rays looking it up.
     pub dome_samples: u64,
@@ -63,6 +65,7 @@ impl AddAssign for Counters {
         self.emission_lookups += o.emission_lookups;
         self.nee_rays_distant += o.nee_rays_distant;
         self.nee_rays_dome += o.nee_rays_dome;
+        self.nee_rays_sphere += o.nee_rays_sphere;
         self.dome_samples += o.dome_samples;
         self.sunward_rays += o.sunward_rays;
     }

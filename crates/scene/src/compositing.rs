@@ -6,7 +6,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use cirrus_deep_exr::DeepImage;
-use cirrus_render::compositing::{cryptomatte, DEFAULT_FAR, DEFAULT_LIGHT_GROUPS};
+use cirrus_render::compositing::{cryptomatte, DEFAULT_FAR};
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{DepthHoldout, IntegratorKind, Layers, RenderSettings, Rendered};
 
@@ -130,7 +130,7 @@ pub(crate) fn configure(
 ) -> Result<()> {
     let c = &mut settings.compositing;
     if asked.light_groups {
-        c.light_groups = DEFAULT_LIGHT_GROUPS.iter().map(|s| s.to_string()).collect();
+        c.light_groups = crate::lights::light_group_names(desc)?;
     }
     c.cryptomatte = asked.cryptomatte;
     c.deep_samples = asked.deep_samples;

@@ -7,7 +7,8 @@
 //! 1. its world box meets the camera's frustum (of the crop window, if
 //!    any), or
 //! 2. paths may scatter and then travel in any direction: an environment
-//!    light (its shadow rays go everywhere), an emitting volume anywhere
+//!    light (its shadow rays go everywhere), a sphere light (its shadow
+//!    rays converge on it from everywhere), an emitting volume anywhere
 //!    (phase-sampled rays look for it), or more than one scattering event
 //!    allowed (`max_depth` unset or >= 2) -- then every volume is loaded;
 //!    or
@@ -19,7 +20,7 @@
 //! boxes (conservative: a box may be kept whose contents are not needed).
 
 use cirrus_bricks::{Bounds3, DBounds3};
-use cirrus_render::{Camera, Crop, Lights};
+use cirrus_render::{Camera, Crop, LightKind, Lights};
 use glam::{DVec3, Vec3};
 
 /// Whether `b` (render space) meets the frustum of pixels `crop` of `camera`.
@@ -81,8 +82,9 @@ pub fn needed(
     if max_depth == Some(0) {
         return visible.to_vec();
     }
-    let scattered_anywhere =
-        lights.domes().next().is_some() || any_emission || max_depth.is_none_or(|d| d >= 2);
+    let scattered_anywhere = lights.iter().any(|l| l.kind() != LightKind::Distant)
+        || any_emission
+        || max_depth.is_none_or(|d| d >= 2);
     if scattered_anywhere {
         return vec![true; n];
     }

@@ -130,7 +130,7 @@ pub(crate) fn set<T: Clone>(slot: &mut Option<T>, value: &Option<T>) {
 ///     keyword (as "toml key")? : Type (, serde(...))?, flag(clap arg attributes),
 ///         (default(value) | unset("what absent means"))?, example(value);
 ///     @file_only { /// docs
-///         key: Type (= serde(...))?; }
+///         field (as "toml key")? : Type (= serde(...))?; }
 /// }
 /// ```
 ///
@@ -155,7 +155,7 @@ macro_rules! declare_settings {
                 @file_only {
                     $(
                         $(#[doc = $fdoc:literal])*
-                        $ffield:ident : $fty:ty $(= serde($($fserde:tt)*))?;
+                        $ffield:ident $(as $fkey:literal)? : $fty:ty $(= serde($($fserde:tt)*))?;
                     )*
                 }
             )?
@@ -175,6 +175,7 @@ macro_rules! declare_settings {
                 )*
                 $($(
                     $(#[doc = $fdoc])*
+                    $(#[serde(rename = $fkey)])?
                     $(#[serde($($fserde)*)])?
                     pub $ffield: $fty,
                 )*)?
@@ -207,6 +208,7 @@ macro_rules! declare_settings {
             #[cfg(feature = "clap")]
             impl $Flags {
                 /// Writes the flags given into `o`.
+                #[allow(unused_variables)]
                 pub fn write_into(&self, o: &mut Overrides) {
                     $(
                         $crate::declare::set(&mut o.$field, &self.$field);
@@ -272,7 +274,7 @@ macro_rules! declare_settings {
                 $($(
                     all.push($crate::declare::SettingInfo {
                         table,
-                        key: stringify!($ffield),
+                        key: declare_settings!(@name $ffield $($fkey)?),
                         keyword: "",
                         help: $crate::declare::help(&[$($fdoc),*], None),
                         default: None,
@@ -312,6 +314,7 @@ macro_rules! declare_settings {
         }
     };
     (@apply each, $t:ident, ($($place:tt)*), [$($given:expr),*], { $($body:tt)* }) => {
+        #[allow(unused_variables)]
         for $t in &mut $($place)* {
             $($body)*
         }

@@ -235,6 +235,52 @@ declare_settings! {
     env_intensity as "intensity": f32, flag(long), default(1.0), example(2.0);
     }
 
+    /// `[[light]]`: one light of any kind, any number of them. A scene with
+    /// a `[[light]]` has the sun and sky only where `[sun]` and
+    /// `[environment]` (or their flags) are given.
+    table lights as "light": LightSpec, LightFlags, each {
+    @file_only {
+        /// `distant`, `sphere`, `point` (a sphere of radius 0), `spot` (a
+        /// sphere or point in a cone) or `dome`.
+        kind as "type": String;
+        /// The light's name: its light-group layer where no `group` is
+        /// given (unnamed lights join `sun`, `sky` or `lights` by kind).
+        name: Option<String>;
+        /// The light-group layer its light goes to.
+        group: Option<String>;
+        /// Where a sphere, point or spot light is.
+        position: Option<[f32; 3]>;
+        /// Direction a distant light's light travels, or a spot's axis.
+        direction: Option<[f32; 3]>;
+        /// A sphere or spot light's radius (sphere default 0.5, UsdLux's).
+        radius: Option<f32>;
+        /// Colour, multiplying `intensity` (default 1,1,1).
+        color: Option<[f32; 3]>;
+        /// The light's strength (default 1), times `2^exposure` and
+        /// `color`: a distant light's irradiance (W/m^2, as `[sun]`), a
+        /// sphere's surface radiance (UsdLux; a point's radiant intensity,
+        /// W/sr), a dome's radiance or its map's multiplier.
+        intensity: Option<f32>;
+        /// Stops (default 0): `intensity * 2^exposure`.
+        exposure: Option<f32>;
+        /// A sphere light's radiance divided by its area `4 pi r^2`, so its
+        /// power does not change with its radius (UsdLux `normalize`).
+        normalize: Option<bool>;
+        /// A distant light's angular diameter in degrees (default 0.53).
+        angle: Option<f32>;
+        /// A spot's cone, half-angle off its axis in degrees (UsdLux
+        /// `shaping:cone:angle`; Blender's spot size is twice it).
+        cone_angle: Option<f32>;
+        /// A spot's edge softness in [0, 1] (default 0; UsdLux
+        /// `shaping:cone:softness`, Blender's spot blend).
+        cone_softness: Option<f32>;
+        /// A dome's lat-long HDR map (EXR, relative to the scene file).
+        map: Option<PathBuf>;
+        /// A dome map's rotation about +Y in degrees.
+        rotation: Option<f32>;
+    }
+    }
+
     /// `[[volume]]`: one volume instance; a flag applies to every volume.
     table volumes as "volume": VolumeSpec, VolumeFlags, each {
     /// The density grid.
@@ -342,6 +388,7 @@ impl SceneDescription {
         if let Some(map) = self.environment.as_mut().and_then(|e| e.env_map.as_mut()) {
             *map = dir.join(&*map);
         }
+        crate::lights::rebase(&mut self.lights, dir);
         if let Some(spec) = self.render.holdout_depth.as_mut() {
             let (file, channel) = crate::parse::split_depth_spec(spec);
             let file = dir.join(file).display().to_string();
@@ -361,6 +408,9 @@ impl SceneDescription {
         }
         self.hold_file_samples();
         if let Some(map) = self.environment.as_mut().and_then(|e| e.env_map.as_mut()) {
+            *map = substitute(map, frame);
+        }
+        for map in self.lights.iter_mut().filter_map(|l| l.map.as_mut()) {
             *map = substitute(map, frame);
         }
         let o = &mut self.output;
@@ -406,6 +456,7 @@ impl SceneDescription {
             v.check()
                 .map_err(|e| format!("volume {} ({}): {e}", i + 1, v.file.display()))?;
         }
+        crate::lights::check_all(&self.lights)?;
         self.camera.check().map_err(|e| format!("[camera] {e}"))
     }
 }

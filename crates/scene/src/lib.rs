@@ -46,6 +46,7 @@ mod flags;
 pub mod frames;
 pub mod grids;
 pub mod info;
+pub mod lights;
 mod moving;
 mod output;
 mod overrides;

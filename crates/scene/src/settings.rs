@@ -2,9 +2,7 @@
 //! lights and render settings, with every default applied. Per-volume
 //! values are resolved by the volume's plan (`plan.rs`).
 
-use std::sync::Arc;
-
-use cirrus_render::{Adaptive, Budget, EnvMap, Environment, Lights, RenderSettings, Shutter, Sun};
+use cirrus_render::{Adaptive, Budget, Lights, RenderSettings, Shutter};
 use glam::{DVec3, Vec3};
 
 use crate::description::SceneDescription;
@@ -75,31 +73,10 @@ impl SceneSettings {
             look_at,
             camera_up: Vec3::from_array(c.camera_up()),
             fov: c.fov(),
-            lights: lights(desc)?,
+            lights: crate::lights::lights(desc)?,
             render,
             refine_optical_depth: r.refine_optical_depth(),
             denoise: r.denoise(),
         })
     }
-}
-
-/// The sun and sky of `desc`; absent or black lights pruned.
-fn lights(desc: &SceneDescription) -> Result<Lights> {
-    let sun = desc.sun.clone().unwrap_or_default();
-    let sun = sun.sun().then(|| {
-        Sun::new(
-            Vec3::from_array(sun.sun_dir()),
-            Vec3::from_array(sun.sun_irradiance()),
-            sun.sun_angle().to_radians(),
-        )
-    });
-    let env = desc.environment.clone().unwrap_or_default();
-    let environment = match &env.env_map {
-        None => Environment::new(Vec3::from_array(env.env_radiance())),
-        Some(path) => {
-            let map = EnvMap::read_exr(path, env.env_rotation())?;
-            Environment::from_map(Arc::new(map), Vec3::splat(env.env_intensity()))
-        }
-    };
-    Ok(Lights::sun_and_sky(sun, Some(environment)).pruned())
 }

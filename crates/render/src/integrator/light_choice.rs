@@ -50,7 +50,7 @@ use glam::Vec3;
 
 use super::per_light::{into_shares, lane_shares, lanes_of, raise_to_floors, Lanes, Shares};
 pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
-use crate::light::{Light, Lights};
+use crate::light::{Light, Lights, SphereLight};
 use crate::phase::Phase;
 use crate::sampling::UNIFORM_SPHERE_PDF;
 
@@ -143,6 +143,17 @@ pub(crate) enum LightChoice {
     Pick(PerLight),
 }
 
+/// Where a light lies, for its weight at a vertex.
+#[derive(Clone, Copy, Debug)]
+enum Aim {
+    /// Toward a distant light's centre.
+    Distant(Vec3),
+    /// From every direction.
+    Dome,
+    /// At a sphere light, its light falling off with distance.
+    Sphere(SphereLight),
+}
+
 /// The light choice of a render: what it weighs each light by, kept flat
 /// and built once from the lights (as pbrt-v4's light samplers keep
 /// theirs), and the pick at a vertex from it.
@@ -153,9 +164,8 @@ pub(crate) struct LightSampler {
     /// Per light, the luminance of a distant light's irradiance or of a
     /// dome's mean radiance.
     luminance: Vec<f32>,
-    /// Per light, the direction toward a distant light's centre (`None`
-    /// for a dome).
-    to_light: Vec<Option<Vec3>>,
+    /// Per light, where it lies: what its weight at a vertex depends on.
+    aim: Vec<Aim>,
     /// Per light, a distant light's disc's solid angle (0 for a delta
     /// light or a dome: no floor).
     disc: Vec<f32>,
@@ -170,11 +180,12 @@ pub(crate) struct LightSampler {
 impl LightSampler {
     /// The choice `sampling` (resolved here) makes among `lights`.
     pub fn new(lights: &Lights, sampling: LightSampling) -> Self {
-        let (to_light, disc) = lights
+        let (aim, disc) = lights
             .iter()
             .map(|light| match light {
-                Light::Distant(sun) => (Some(-sun.direction()), sun.solid_angle()),
-                Light::Dome(_) => (None, 0.0),
+                Light::Distant(sun) => (Aim::Distant(-sun.direction()), sun.solid_angle()),
+                Light::Dome(_) => (Aim::Dome, 0.0),
+                Light::Sphere(s) => (Aim::Sphere(*s), 0.0),
             })
             .unzip();
         let luminance: Vec<f32> = lights.iter().map(Light::luminance).collect();
@@ -183,12 +194,15 @@ impl LightSampler {
             *w = match light {
                 Light::Distant(_) => l * UNIFORM_SPHERE_PDF,
                 Light::Dome(_) => *l,
+                // Its weight depends on where the vertex is, which the
+                // estimate does not know.
+                Light::Sphere(_) => 0.0,
             };
         }
         Self {
             sampling: sampling.resolve(lights),
             luminance,
-            to_light,
+            aim,
             disc,
             isotropic,
             lanes: lanes_of(lights.len()),
@@ -207,45 +221,49 @@ impl LightSampler {
         self.sampling == LightSampling::One && self.luminance.len() >= 2
     }
 
-    /// Light `i`'s unoccluded in-scattered luminance at a vertex reached
-    /// along `dir_in` (`f E` toward a distant light's centre, a dome's mean
-    /// radiance: the phase function integrates to 1 over the sphere), and
-    /// the least probability its disc needs ([`disc_floor`]; 0 for other
-    /// lights).
+    /// Light `i`'s unoccluded in-scattered luminance at a vertex at `p`
+    /// reached along `dir_in` (`f E` toward a distant light's centre, a
+    /// dome's mean radiance: the phase function integrates to 1 over the
+    /// sphere; `f I / d^2` toward a sphere light), and the least
+    /// probability its disc needs ([`disc_floor`]; 0 for other lights).
     #[inline(always)]
-    fn weigh(&self, i: usize, phase: &Phase, dir_in: Vec3) -> (f32, f32) {
-        match self.to_light[i] {
-            Some(to_light) => {
-                let f = phase.eval(dir_in, to_light);
+    fn weigh(&self, i: usize, phase: &Phase, p: Vec3, dir_in: Vec3) -> (f32, f32) {
+        match &self.aim[i] {
+            Aim::Distant(to_light) => {
+                let f = phase.eval(dir_in, *to_light);
                 let disc = self.disc[i];
                 let floor = if disc > 0.0 { disc_floor(f, disc) } else { 0.0 };
                 (self.luminance[i] * f, floor)
             }
-            None => (self.luminance[i], 0.0),
+            Aim::Dome => (self.luminance[i], 0.0),
+            Aim::Sphere(s) => {
+                let f = phase.eval(dir_in, (s.position() - p).normalize_or_zero());
+                (s.luminance_at(p, self.luminance[i]) * f, 0.0)
+            }
         }
     }
 
     /// [`Self::weigh`] of every light, the weights and the floors apart.
     #[inline(always)]
-    fn weigh_all(&self, phase: &Phase, dir_in: Vec3) -> (PerLight, PerLight) {
+    fn weigh_all(&self, phase: &Phase, p: Vec3, dir_in: Vec3) -> (PerLight, PerLight) {
         let n = self.luminance.len();
         let (mut open, mut floors) = (PerLight::zeros(n), PerLight::zeros(n));
         for (i, (open, floor)) in open.iter_mut().zip(floors.iter_mut()).enumerate() {
-            (*open, *floor) = self.weigh(i, phase, dir_in);
+            (*open, *floor) = self.weigh(i, phase, p, dir_in);
         }
         (open, floors)
     }
 
-    /// The pick at a vertex reached along `dir_in` with phase function
-    /// `phase`, each light weighed by its unoccluded in-scattered light:
-    /// [`LightChoice::All`] unless the sampling is `one` and there are
-    /// lights to choose among.
+    /// The pick at a vertex at `at` reached along `dir_in` with phase
+    /// function `phase`, each light weighed by its unoccluded in-scattered
+    /// light: [`LightChoice::All`] unless the sampling is `one` and there
+    /// are lights to choose among.
     #[inline]
-    pub fn at(&self, phase: &Phase, dir_in: Vec3) -> LightChoice {
+    pub fn at(&self, phase: &Phase, at: Vec3, dir_in: Vec3) -> LightChoice {
         if !self.picks() {
             return LightChoice::All;
         }
-        let (mut p, floors) = self.weigh_all(phase, dir_in);
+        let (mut p, floors) = self.weigh_all(phase, at, dir_in);
         into_shares(&mut p);
         raise_to_floors(&mut p, &floors);
         LightChoice::Pick(p)
@@ -272,19 +290,19 @@ impl LightSampler {
         }
     }
 
-    /// The pick at a vertex reached along `dir_in` with phase function
-    /// `phase` (`one`), which sees the fractions `seen` of each light's
+    /// The pick at a vertex at `at` reached along `dir_in` with phase
+    /// function `phase` (`one`), which sees the fractions `seen` of each light's
     /// in-scattered light through the media (a shadow grid's estimate):
     /// the lights weighed by what they bring through the media, and no
     /// light at all, with the remaining probability, where the vertex sees
     /// less than [`TRACE_FRACTION`] of its unoccluded light.
     #[inline]
-    pub fn shadowed(&self, seen: &PerLight, phase: &Phase, dir_in: Vec3) -> LightChoice {
+    pub fn shadowed(&self, seen: &PerLight, phase: &Phase, at: Vec3, dir_in: Vec3) -> LightChoice {
         // Each light's unoccluded light and its disc's floor, then, over
         // the lanes (this runs at every vertex), what each brings through
         // the media and its share.
         let n = self.luminance.len();
-        let (open, floors) = self.weigh_all(phase, dir_in);
+        let (open, floors) = self.weigh_all(phase, at, dir_in);
         let (open, seen) = (open.lanes(), seen.lanes());
         let through = [open[0] * seen[0], open[1] * seen[1]];
         let open_total = open[0].element_sum() + open[1].element_sum();
@@ -377,7 +395,7 @@ mod tests {
             (Vec3::X, "side"),
             (Vec3::new(0.3, 0.5, -0.2).normalize(), "oblique"),
         ] {
-            let c = LightSampler::new(&l, LightSampling::One).at(&phase, dir_in);
+            let c = LightSampler::new(&l, LightSampling::One).at(&phase, Vec3::ZERO, dir_in);
             let p = probabilities(&c);
             assert!((p[0] - expected(dir_in)).abs() < 1e-6, "{label}: {c:?}");
             assert!((p[0] + p[1] - 1.0).abs() < 1e-6, "{label}: {c:?}");
@@ -388,8 +406,8 @@ mod tests {
                 "{label}: {facing} against {c:?}"
             );
         }
-        let away = LightSampler::new(&l, LightSampling::One).at(&phase, Vec3::NEG_Y);
-        let toward = LightSampler::new(&l, LightSampling::One).at(&phase, Vec3::Y);
+        let away = LightSampler::new(&l, LightSampling::One).at(&phase, Vec3::ZERO, Vec3::NEG_Y);
+        let toward = LightSampler::new(&l, LightSampling::One).at(&phase, Vec3::ZERO, Vec3::Y);
         assert!(probabilities(&away)[0] < 0.1, "{away:?}");
         assert!((probabilities(&toward)[0] - (1.0 - MIN_PROBABILITY)).abs() < 1e-6);
     }
@@ -460,7 +478,7 @@ mod tests {
         let phase = Phase::hg(0.3);
         let l = lights();
         assert_eq!(
-            LightSampler::new(&l, LightSampling::All).at(&phase, Vec3::X),
+            LightSampler::new(&l, LightSampling::All).at(&phase, Vec3::ZERO, Vec3::X),
             LightChoice::All
         );
         assert_eq!(LightSampling::Auto.resolve(&l), LightSampling::One);
@@ -472,7 +490,7 @@ mod tests {
         let sun_only = Lights::sun_and_sky(Some(sun), None);
         assert_eq!(LightSampling::Auto.resolve(&sun_only), LightSampling::All);
         assert_eq!(
-            LightSampler::new(&sun_only, LightSampling::One).at(&phase, Vec3::X),
+            LightSampler::new(&sun_only, LightSampling::One).at(&phase, Vec3::ZERO, Vec3::X),
             LightChoice::All
         );
     }
@@ -494,7 +512,7 @@ mod tests {
         let sky = || Light::from(Environment::new(Vec3::splat(0.2)));
         let most = Lights::new((0..MAX_PICKED_LIGHTS - 1).map(sun).chain([sky()]));
         assert_eq!(LightSampling::Auto.resolve(&most), LightSampling::One);
-        let c = LightSampler::new(&most, LightSampling::Auto).at(&phase, Vec3::X);
+        let c = LightSampler::new(&most, LightSampling::Auto).at(&phase, Vec3::ZERO, Vec3::X);
         let p = probabilities(&c);
         assert_eq!(p.len(), MAX_PICKED_LIGHTS);
         let floor = MIN_PROBABILITY.min(0.5 / MAX_PICKED_LIGHTS as f32);
@@ -503,7 +521,7 @@ mod tests {
         let too_many = Lights::new((0..MAX_PICKED_LIGHTS).map(sun).chain([sky()]));
         assert_eq!(LightSampling::One.resolve(&too_many), LightSampling::All);
         let sampler = LightSampler::new(&too_many, LightSampling::One);
-        assert_eq!(sampler.at(&phase, Vec3::X), LightChoice::All);
+        assert_eq!(sampler.at(&phase, Vec3::ZERO, Vec3::X), LightChoice::All);
         assert_eq!(sampler.facing(0, 1.0), 1.0);
     }
 
@@ -528,7 +546,7 @@ mod tests {
         let dir_in = Vec3::new(0.3, 0.5, -0.2).normalize();
         let shadowed = |l: &Lights, grid: &LightGrid, p: Vec3| {
             let sampler = LightSampler::new(l, LightSampling::One);
-            let c = sampler.shadowed(&grid.seen(&phase, p, dir_in), &phase, dir_in);
+            let c = sampler.shadowed(&grid.seen(&phase, p, dir_in), &phase, p, dir_in);
             probabilities(&c).to_vec()
         };
         let deep = shadowed(&l, &grid, Vec3::splat(2.0));
@@ -546,7 +564,7 @@ mod tests {
         assert!((lit[0] - share).abs() < 1e-5, "{lit:?} against {share}");
         // The unoccluded pick does not see the cube, so it weighs the two
         // lights otherwise.
-        let open = LightSampler::new(&l, LightSampling::One).at(&phase, dir_in);
+        let open = LightSampler::new(&l, LightSampling::One).at(&phase, Vec3::ZERO, dir_in);
         assert!(lit[0] != probabilities(&open)[0], "{lit:?} {open:?}");
         let sky_only = Lights::sun_and_sky(None, Some(Environment::new(Vec3::splat(0.2))));
         let grid = cube_grid(&sky_only);

@@ -246,6 +246,7 @@ impl LightGrid {
                         medium,
                         p,
                         -sun.direction(),
+                        f32::INFINITY,
                         step,
                         ShadowEnd::Cutoff,
                         rng,
@@ -264,6 +265,7 @@ impl LightGrid {
                             medium,
                             p,
                             w,
+                            f32::INFINITY,
                             step,
                             ShadowEnd::Cutoff,
                             rng,
@@ -275,6 +277,21 @@ impl LightGrid {
                     let inv = 1.0 / env_dirs as f32;
                     let b = b * inv;
                     *slot = Vec4::new(a * inv, b.x, b.y, b.z);
+                }
+                Light::Sphere(light) => {
+                    // Toward the centre, to the ball's surface.
+                    let to = light.position() - p;
+                    let d = to.length();
+                    slot.x = marched_transmittance::<M, f32>(
+                        medium,
+                        p,
+                        to / d,
+                        (d - light.radius()).max(0.0),
+                        step,
+                        ShadowEnd::Cutoff,
+                        rng,
+                        c,
+                    );
                 }
             }
         }
@@ -402,7 +419,7 @@ impl LightGrid {
     #[inline]
     fn seen_in(kind: LightKind, slot: Vec4, phase: &Phase, dir: Vec3) -> f32 {
         match kind {
-            LightKind::Distant => slot.x,
+            LightKind::Distant | LightKind::Sphere => slot.x,
             LightKind::Dome => (slot.x + 3.0 * phase.mean_cosine() * slot.yzw().dot(dir)).max(0.0),
         }
     }
@@ -429,6 +446,14 @@ impl LightGrid {
                     sun.irradiance() * (f * seen)
                 }
                 Light::Dome(env) => env.mean_radiance() * seen,
+                Light::Sphere(light) => {
+                    // The ball taken for a point at its centre.
+                    let to = light.position() - p;
+                    let d2 = to.length_squared().max(light.radius() * light.radius());
+                    let w = to.normalize_or_zero();
+                    let f = phase.eval(dir, w) * light.falloff(-w);
+                    light.intensity() * (f * seen / d2)
+                }
             };
             s.add(lights.group(i), l);
             i += 1;

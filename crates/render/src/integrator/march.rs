@@ -78,11 +78,14 @@ pub(crate) enum ShadowEnd {
 }
 
 /// The jittered-march estimate of the transmittance from `p` toward `dir`
-/// (to infinity): `exp(-tau)`, ended as `end` says; counts one shadow ray.
+/// over distance `t_max` (infinite toward lights at infinity):
+/// `exp(-tau)`, ended as `end` says; counts one shadow ray.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn marched_transmittance<M: Media, E: Spectrum>(
     medium: &M,
     p: Vec3,
     dir: Vec3,
+    t_max: f32,
     h: f32,
     end: ShadowEnd,
     rng: &mut Rng,
@@ -94,7 +97,7 @@ pub(crate) fn marched_transmittance<M: Media, E: Spectrum>(
     match end {
         ShadowEnd::Cutoff => {
             let mut tau = E::ZERO;
-            march(medium, &ray, f32::INFINITY, h, u, c, |_, sigma: E, _| {
+            march(medium, &ray, t_max, h, u, c, |_, sigma: E, _| {
                 tau = tau.add(sigma.scale(h));
                 tau.min_channel() < TAU_CUTOFF
             });
@@ -110,7 +113,7 @@ pub(crate) fn marched_transmittance<M: Media, E: Spectrum>(
             let mut w = 1.0f32;
             let mut tau_roulette = ROULETTE_THRESHOLD.recip().ln();
             let mut survived = true;
-            march(medium, &ray, f32::INFINITY, h, u, c, |_, sigma: E, _| {
+            march(medium, &ray, t_max, h, u, c, |_, sigma: E, _| {
                 if !sigma.any_positive() {
                     return true;
                 }
@@ -239,14 +242,23 @@ mod tests {
             let (mut exact, mut exact2, mut sum, mut sum2) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
             for _ in 0..n {
                 let mut c = Counters::default();
-                let e: f32 =
-                    marched_transmittance(&medium, p, dir, h, ShadowEnd::Cutoff, &mut rng, &mut c);
+                let e: f32 = marched_transmittance(
+                    &medium,
+                    p,
+                    dir,
+                    f32::INFINITY,
+                    h,
+                    ShadowEnd::Cutoff,
+                    &mut rng,
+                    &mut c,
+                );
                 cutoff_lookups += c.density_lookups;
                 let mut c = Counters::default();
                 let r: f32 = marched_transmittance(
                     &medium,
                     p,
                     dir,
+                    f32::INFINITY,
                     h,
                     ShadowEnd::Roulette,
                     &mut rng,

@@ -11,6 +11,7 @@ mod light_choice;
 mod light_grid;
 mod march;
 mod path;
+mod path_flight;
 mod path_light;
 mod path_state;
 mod path_sunward;

@@ -1,5 +1,6 @@
-//! Volumetric path tracing: the path loop (`path.rs`), next-event
-//! estimation (`path_light.rs`) and sunward scattering (`path_sunward.rs`).
+//! Volumetric path tracing: the path loop (`path.rs`), the free flight
+//! past sphere lights (`path_flight.rs`), next-event estimation
+//! (`path_light.rs`) and sunward scattering (`path_sunward.rs`).
 
 use glam::Vec3;
 
@@ -17,7 +18,7 @@ use crate::sampling::{Draw, Rng, SampleStream};
 use crate::spectrum::luminance;
 use crate::spectrum::Spectrum;
 use crate::stats::Counters;
-use crate::tracking::{sample_free_flight, FreeFlight, TransmittanceEstimator};
+use crate::tracking::{FreeFlight, TransmittanceEstimator};
 
 /// Russian roulette on path throughput starts after this many scattering
 /// events...
@@ -86,9 +87,11 @@ pub struct PathTracer<'a, M> {
     pub(super) estimator: TransmittanceEstimator,
     pub(super) max_depth: Option<u32>,
     chromatic: bool,
+    /// Whether any light is a ball that rays can meet (`path_flight.rs`).
+    pub(super) has_balls: bool,
     /// Tag contributions with their light groups (off: `Sample::groups`
     /// stays zero and costs nothing).
-    light_groups: bool,
+    pub(super) light_groups: bool,
     /// Which lights each vertex samples ([`LightSampling`]).
     pub(super) sampler: LightSampler,
     /// Where the next vertex's sunlight is gathered by sunward scattering
@@ -109,6 +112,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         max_depth: Option<u32>,
     ) -> Self {
         let lights = lights.pruned();
+        let has_balls = lights.balls().next().is_some();
         // The first of the brightest, where several are alike.
         let sunward_light = lights
             .distant()
@@ -117,6 +121,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             .map(|(i, _)| i);
         Self {
             medium,
+            has_balls,
             sunward_light,
             sampler: LightSampler::new(&lights, LightSampling::default()),
             lights,
@@ -151,20 +156,21 @@ impl<'a, M: Media> PathTracer<'a, M> {
         self.shadows.map(|grid| grid.seen(phase, p, dir_in))
     }
 
-    /// Which lights a vertex reached along `dir_in`, which sees `seen`
-    /// ([`Self::seen`]), samples.
+    /// Which lights a vertex at `p` reached along `dir_in`, which sees
+    /// `seen` ([`Self::seen`]), samples.
     #[inline]
     pub(super) fn light_choice(
         &self,
         phase: &Phase,
+        p: Vec3,
         dir_in: Vec3,
         seen: Option<&PerLight>,
     ) -> LightChoice {
         match seen {
             Some(seen) if self.sampler.sampling() == LightSampling::One => {
-                self.sampler.shadowed(seen, phase, dir_in)
+                self.sampler.shadowed(seen, phase, p, dir_in)
             }
-            _ => self.sampler.at(phase, dir_in),
+            _ => self.sampler.at(phase, p, dir_in),
         }
     }
 
@@ -196,7 +202,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         let i = self.sunward_light?;
         match self.lights.get(i) {
             Light::Distant(sun) => Some((i, sun)),
-            Light::Dome(_) => None,
+            _ => None,
         }
     }
 }
@@ -245,10 +251,7 @@ impl<M: Media> PathTracer<'_, M> {
             // This free flight and the events at its collision are path
             // vertex `path.depth` of the draw allocation.
             let vertex = path.depth;
-            let ray = path.ray;
-            let flight = draws.leading(Draw::FreeFlight, vertex, |rng| {
-                sample_free_flight::<S, M>(self.medium, &ray, ray.t_max, &mut path.beta, rng, c)
-            });
+            let flight = self.fly::<S>(&mut path, vertex, draws, c);
             if path.depth == 0 {
                 path.out.alpha = match flight {
                     FreeFlight::Escaped => S::escaped_alpha(path.beta),
@@ -355,7 +358,7 @@ impl<M: Media> PathTracer<'_, M> {
             phase: at.phase,
             mis: !last,
             index: vertex,
-            choice: self.light_choice(at.phase, ray_in.dir, seen.as_ref()),
+            choice: self.light_choice(at.phase, p, ray_in.dir, seen.as_ref()),
             arrival: path.arrival,
         };
         let parts = self.direct_light::<S>(&v, draws, c);

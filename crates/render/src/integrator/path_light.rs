@@ -82,6 +82,16 @@ impl<M: Media> PathTracer<'_, M> {
                 c.nee_rays_dome += u64::from(s.pdf.is_some_and(|p| p > 0.0));
                 self.light_term::<S>(v, s, pick, shadow, draws, c)
             }
+            Light::Sphere(light) => {
+                let s = light.sample(v.p, u1, u2);
+                // Outside a spot's cone, or inside the ball: no light, no
+                // shadow ray.
+                if s.radiance == Vec3::ZERO {
+                    return Vec3::ZERO;
+                }
+                c.nee_rays_sphere += 1;
+                self.light_term::<S>(v, s, pick, shadow, draws, c)
+            }
         }
     }
 
@@ -102,6 +112,7 @@ impl<M: Media> PathTracer<'_, M> {
             to_light,
             radiance: env.radiance,
             pdf: Some(pdf),
+            distance: f32::INFINITY,
         }
     }
 
@@ -135,7 +146,7 @@ impl<M: Media> PathTracer<'_, M> {
         };
         let shadow = v.ray_in.spawn(v.p, s.to_light);
         let tr = draws.leading(shadow_draw, v.index, |rng| {
-            transmittance::<S, M>(self.estimator, self.medium, &shadow, f32::INFINITY, rng, c)
+            transmittance::<S, M>(self.estimator, self.medium, &shadow, s.distance, rng, c)
         });
         s.radiance * (weight * tr.rgb())
     }

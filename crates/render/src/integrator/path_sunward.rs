@@ -197,7 +197,7 @@ impl<M: Media> PathTracer<'_, M> {
         // with this probability (its shadow grid's, as the continuation's
         // own vertex there computes it).
         let pick = self
-            .light_choice(it.phase, w, self.seen(it.phase, p, w).as_ref())
+            .light_choice(it.phase, p, w, self.seen(it.phase, p, w).as_ref())
             .probability(light);
         let weight = sunward_weight(q, f, pick);
         let s = sun.sample(rng.uniform(), rng.uniform());

@@ -66,31 +66,41 @@ impl<'a, M: Media> RayMarcher<'a, M> {
     ) -> LightParts {
         let mut s = LightParts::default();
         for (i, light) in self.lights.iter().enumerate() {
-            // A distant light's disc sampled uniformly (radiance / pdf is
-            // the irradiance); a dome along a phase-sampled direction.
-            let (w, f) = match light {
+            // A distant light's disc and a sphere light's cone sampled
+            // uniformly (radiance / pdf is what they deliver); a dome along
+            // a phase-sampled direction.
+            let (u1, u2) = (rng.uniform(), rng.uniform());
+            let (w, f, radiance, t_max) = match light {
                 Light::Distant(sun) => {
-                    let ls = sun.sample(rng.uniform(), rng.uniform());
-                    (ls.to_light, phase.eval(dir, ls.to_light))
+                    let ls = sun.sample(u1, u2);
+                    let f = phase.eval(dir, ls.to_light);
+                    (ls.to_light, f, sun.irradiance(), f32::INFINITY)
                 }
-                Light::Dome(_) => (phase.sample(dir, rng.uniform(), rng.uniform()).0, 1.0),
+                Light::Dome(env) => {
+                    c.dome_samples += 1;
+                    let w = phase.sample(dir, u1, u2).0;
+                    (w, 1.0, env.eval(w).0, f32::INFINITY)
+                }
+                Light::Sphere(sphere) => {
+                    let ls = sphere.sample(p, u1, u2);
+                    if ls.radiance == Vec3::ZERO {
+                        continue;
+                    }
+                    let f = phase.eval(dir, ls.to_light) / ls.pdf.unwrap_or(1.0);
+                    (ls.to_light, f, ls.radiance, ls.distance)
+                }
             };
             let tr: E = marched_transmittance(
                 self.medium,
                 p,
                 w,
+                t_max,
                 self.shadow_step,
                 ShadowEnd::Roulette,
                 rng,
                 c,
             );
-            let l = match light {
-                Light::Distant(sun) => tr.scale(f).tint(sun.irradiance()),
-                Light::Dome(env) => {
-                    c.dome_samples += 1;
-                    tr.tint(env.eval(w).0)
-                }
-            };
+            let l = tr.scale(f).tint(radiance);
             s.add(self.lights.group(i), l);
         }
         s

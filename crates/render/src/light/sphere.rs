@@ -1,0 +1,308 @@
+//! Sphere lights: a ball of uniform radiance emitting outward (UsdLux's
+//! `SphereLight`, Blender's point lamp), a true point where its radius is
+//! zero, and shaped into a spot light by a cone.
+//!
+//! A light is described by its radiant intensity `I` (W/sr per channel):
+//! what it sends toward any direction far away. A ball of radius `r` and
+//! radiance `L` sends `I = L pi r^2` (its projected area times `L`), so
+//! the same `I` lights the far field alike at any radius and the radius
+//! only softens shadows and near light.
+//!
+//! Sampling from a point `p` outside the ball draws directions uniformly
+//! inside the cone the ball subtends (pbrt-v4's `SphereLight` and
+//! Cycles' point lights do the same): density `1 / (2 pi (1 - cos
+//! theta_max))` with `sin theta_max = r / d`, the radiance `L` along each
+//! (a sphere of uniform radiance looks like a disc of uniform radiance).
+//! A point light is a delta: `I / d^2` along the one direction. The ball
+//! emits outward only: from inside it nothing is received.
+
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use super::LightSample;
+use crate::sampling::uniform_cone;
+
+/// A spot light's cone about its axis. The light's intensity is scaled by
+/// `smoothstep(cos_outer, cos_inner, cos theta)` at angle `theta` off the
+/// axis, where `cos_inner = cos_outer + softness (1 - cos_outer)`: full
+/// inside the inner cone, none outside the cone's angle (Cycles' spot
+/// blend, UsdLux ShapingAPI's cone angle and softness).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    /// Unit vector along which the spot points, from the light outward.
+    axis: Vec3,
+    cos_outer: f32,
+    cos_inner: f32,
+}
+
+impl Spot {
+    /// A cone of half-angle `half_angle` (radians, in [0, pi]) about
+    /// `axis`, its edge softened over the fraction `softness` (in [0, 1])
+    /// of `1 - cos(half_angle)`.
+    pub fn new(axis: Vec3, half_angle: f32, softness: f32) -> Self {
+        let cos_outer = half_angle.clamp(0.0, PI).cos();
+        let softness = softness.clamp(0.0, 1.0);
+        Self {
+            axis: axis.normalize(),
+            cos_outer,
+            cos_inner: cos_outer + softness * (1.0 - cos_outer),
+        }
+    }
+
+    pub fn axis(&self) -> Vec3 {
+        self.axis
+    }
+
+    /// The fraction of the intensity sent along `dir` (unit, from the light).
+    #[inline]
+    pub fn falloff(&self, dir: Vec3) -> f32 {
+        let c = self.axis.dot(dir);
+        if c <= self.cos_outer {
+            0.0
+        } else if c >= self.cos_inner {
+            1.0
+        } else {
+            let t = (c - self.cos_outer) / (self.cos_inner - self.cos_outer);
+            t * t * (3.0 - 2.0 * t)
+        }
+    }
+}
+
+/// A sphere (or point) light, optionally shaped by a spot cone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereLight {
+    position: Vec3,
+    radius: f32,
+    /// Radiant intensity, W/sr per channel.
+    intensity: Vec3,
+    spot: Option<Spot>,
+}
+
+impl SphereLight {
+    /// A light at `position` of radius `radius` (0: a point) sending the
+    /// radiant intensity `intensity` (W/sr per channel) toward every
+    /// direction.
+    pub fn new(position: Vec3, radius: f32, intensity: Vec3) -> Self {
+        Self {
+            position,
+            radius: radius.max(0.0),
+            intensity,
+            spot: None,
+        }
+    }
+
+    /// The same light shaped by `spot`'s cone.
+    pub fn with_spot(self, spot: Spot) -> Self {
+        Self {
+            spot: Some(spot),
+            ..self
+        }
+    }
+
+    pub fn position(&self) -> Vec3 {
+        self.position
+    }
+
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    pub fn intensity(&self) -> Vec3 {
+        self.intensity
+    }
+
+    pub fn spot(&self) -> Option<&Spot> {
+        self.spot.as_ref()
+    }
+
+    /// Whether it is a point, which no ray can hit.
+    pub fn is_point(&self) -> bool {
+        self.radius <= 0.0
+    }
+
+    /// The radiance of its surface, `I / (pi r^2)` (infinite for a point).
+    pub fn radiance(&self) -> Vec3 {
+        self.intensity / (PI * self.radius * self.radius)
+    }
+
+    /// The spot's falloff toward unit direction `dir` from the light's
+    /// centre (1 without a spot).
+    #[inline]
+    pub fn falloff(&self, dir: Vec3) -> f32 {
+        self.spot.map_or(1.0, |s| s.falloff(dir))
+    }
+
+    /// `1 - cos theta_max` of the cone the ball subtends from distance
+    /// `d2.sqrt()` to its centre, as `sin^2 / (1 + cos)` so that a small
+    /// far ball keeps its solid angle; `None` from inside the ball.
+    #[inline]
+    fn cone(&self, d2: f32) -> Option<f32> {
+        let r2 = self.radius * self.radius;
+        if d2 <= r2 {
+            return None;
+        }
+        let sin2 = r2 / d2;
+        Some(sin2 / (1.0 + (1.0 - sin2).sqrt()))
+    }
+
+    /// Samples the light from `p`: a point's one direction, or a direction
+    /// uniform in the cone the ball subtends with the distance to its near
+    /// surface. From inside the ball, a zero-density sample.
+    #[inline]
+    pub fn sample(&self, p: Vec3, u1: f32, u2: f32) -> LightSample {
+        let to_centre = self.position - p;
+        let d2 = to_centre.length_squared();
+        let d = d2.sqrt();
+        let axis = to_centre / d;
+        if self.is_point() {
+            return LightSample {
+                to_light: axis,
+                radiance: self.intensity * (self.falloff(-axis) / d2),
+                pdf: None,
+                distance: d,
+            };
+        }
+        let Some(one_minus_cos) = self.cone(d2) else {
+            return LightSample {
+                to_light: axis,
+                radiance: Vec3::ZERO,
+                pdf: Some(0.0),
+                distance: 0.0,
+            };
+        };
+        let to_light = uniform_cone(axis, one_minus_cos, u1, u2);
+        let distance = self.hit_distance(to_centre, to_light).unwrap_or(d);
+        LightSample {
+            to_light,
+            radiance: self.radiance() * self.falloff(-axis),
+            pdf: Some(1.0 / (2.0 * PI * one_minus_cos)),
+            distance,
+        }
+    }
+
+    /// Where a ray from `p` along unit `dir` first meets the ball's outside
+    /// within `t_max`: the distance, the radiance it sees there and the
+    /// density with which [`Self::sample`] at `p` draws `dir`. `None` for
+    /// a point, a miss, or from inside the ball (which emits outward only).
+    #[inline]
+    pub fn hit(&self, p: Vec3, dir: Vec3, t_max: f32) -> Option<(f32, Vec3, f32)> {
+        if self.is_point() {
+            return None;
+        }
+        let to_centre = self.position - p;
+        let d2 = to_centre.length_squared();
+        let one_minus_cos = self.cone(d2)?;
+        let t = self.hit_distance(to_centre, dir)?;
+        (t < t_max).then(|| {
+            let axis = to_centre / d2.sqrt();
+            let l = self.radiance() * self.falloff(-axis);
+            (t, l, 1.0 / (2.0 * PI * one_minus_cos))
+        })
+    }
+
+    /// The near root of the ray from the ball's outside (`to_centre` from
+    /// the origin to the centre) along unit `dir`, if it meets the ball
+    /// ahead.
+    #[inline]
+    fn hit_distance(&self, to_centre: Vec3, dir: Vec3) -> Option<f32> {
+        let b = to_centre.dot(dir);
+        // The squared distance from the centre to the line, taken from
+        // the perpendicular component so it does not cancel for a small
+        // far ball.
+        let perp2 = (to_centre - b * dir).length_squared();
+        let h2 = self.radius * self.radius - perp2;
+        (b > 0.0 && h2 >= 0.0).then(|| (b - h2.sqrt()).max(0.0))
+    }
+
+    /// What the light sends toward `p` unoccluded, in luminance of the
+    /// irradiance at `p` (`I / d^2`, the spot's falloff, bounded near the
+    /// ball by its radius): what a light choice weighs it by.
+    #[inline]
+    pub fn luminance_at(&self, p: Vec3, luminance: f32) -> f32 {
+        let to_p = p - self.position;
+        let d2 = to_p.length_squared().max(self.radius * self.radius);
+        let falloff = match &self.spot {
+            Some(s) => s.falloff(to_p.normalize_or_zero()),
+            None => 1.0,
+        };
+        luminance * falloff / d2
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_far_ball_subtends_its_projected_area() {
+        let l = SphereLight::new(Vec3::ZERO, 0.01, Vec3::ONE);
+        let omc = l.cone(100.0 * 100.0).unwrap();
+        let solid_angle = 2.0 * PI * omc;
+        let expected = PI * 1e-4 / 1e4;
+        assert!((solid_angle / expected - 1.0).abs() < 1e-4, "{solid_angle}");
+        // Radiance over the solid angle is the point light's I / d^2.
+        let e = l.radiance().x * solid_angle;
+        assert!((e / 1e-4 - 1.0).abs() < 1e-3, "{e}");
+    }
+
+    #[test]
+    fn sampled_directions_meet_the_ball_and_the_hit_agrees() {
+        let l = SphereLight::new(Vec3::new(1.0, 2.0, 3.0), 0.7, Vec3::splat(2.0));
+        let p = Vec3::new(-1.0, 0.5, 0.0);
+        for k in 0..64 {
+            let (u1, u2) = ((k as f32 + 0.5) / 64.0, (k as f32 * 0.618).fract());
+            let s = l.sample(p, u1, u2);
+            let on = p + s.distance * s.to_light;
+            assert!(((on - l.position()).length() - 0.7).abs() < 1e-4);
+            let (t, radiance, pdf) = l.hit(p, s.to_light, f32::INFINITY).unwrap();
+            assert!((t - s.distance).abs() < 1e-4);
+            assert_eq!(radiance, s.radiance);
+            assert_eq!(Some(pdf), s.pdf);
+        }
+        assert!(l.hit(p, -Vec3::X, f32::INFINITY).is_none(), "a miss");
+        assert!(
+            l.hit(l.position(), Vec3::X, f32::INFINITY).is_none(),
+            "inside"
+        );
+        assert!(
+            l.hit(p, (l.position() - p).normalize(), 1.0).is_none(),
+            "beyond t_max"
+        );
+    }
+
+    #[test]
+    fn a_point_is_a_delta_of_intensity_over_distance_squared() {
+        let l = SphereLight::new(Vec3::new(0.0, 4.0, 0.0), 0.0, Vec3::new(8.0, 4.0, 2.0));
+        let s = l.sample(Vec3::ZERO, 0.3, 0.9);
+        assert_eq!(s.pdf, None);
+        assert_eq!(s.to_light, Vec3::Y);
+        assert_eq!(s.distance, 4.0);
+        assert_eq!(s.radiance, Vec3::new(0.5, 0.25, 0.125));
+        assert!(l.hit(Vec3::ZERO, Vec3::Y, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn a_spot_lights_its_cone_and_softens_its_edge() {
+        let spot = Spot::new(-Vec3::Y, 30f32.to_radians(), 0.5);
+        assert_eq!(spot.falloff(-Vec3::Y), 1.0);
+        assert_eq!(spot.falloff(Vec3::X), 0.0);
+        let at = |deg: f32| {
+            let a = deg.to_radians();
+            spot.falloff(Vec3::new(a.sin(), -a.cos(), 0.0))
+        };
+        assert_eq!(at(31.0), 0.0);
+        assert_eq!(at(10.0), 1.0);
+        let (mid, inner) = (at(25.0), at(15.0));
+        assert!(mid > 0.0 && mid < inner && inner <= 1.0, "{mid} {inner}");
+        let l = SphereLight::new(Vec3::Y, 0.0, Vec3::ONE).with_spot(spot);
+        assert_eq!(
+            l.sample(Vec3::new(0.0, -1.0, 0.0), 0.5, 0.5).radiance,
+            Vec3::splat(0.25)
+        );
+        assert_eq!(
+            l.sample(Vec3::new(5.0, 1.0, 0.0), 0.5, 0.5).radiance,
+            Vec3::ZERO
+        );
+    }
+}

@@ -1,0 +1,313 @@
+//! A description's lights: the `[sun]` and `[environment]` shorthands
+//! and the `[[light]]` tables, checked, turned into the renderer's light
+//! list, and each tagged with its light-group layer.
+//!
+//! A light's strength is `intensity * 2^exposure * color`, as UsdLux
+//! writes it: a distant light's irradiance (W/m^2 on a surface facing
+//! it, as `[sun]`), a sphere's surface radiance (divided by its area
+//! `4 pi r^2` where `normalize` is set), a point's radiant intensity
+//! (W/sr; a point has no surface), a dome's radiance or its map's
+//! multiplier. A sphere of radius `r` and radiance `L` lights the far
+//! field as a point of intensity `L pi r^2`.
+//!
+//! Light groups: a light's `group`, else its `name`, else its kind's
+//! layer (`sun` for distant lights, `sky` for domes, `lights` for sphere
+//! and spot lights); the layers are `sun`, `sky` and `emission`, then
+//! the others in the order the lights name them.
+
+use std::f32::consts::PI;
+use std::path::Path;
+use std::sync::Arc;
+
+use cirrus_render::compositing::{DEFAULT_LIGHT_GROUPS, MAX_LIGHT_GROUPS};
+use cirrus_render::{EnvMap, Environment, Light, Lights, SphereLight, Spot, Sun};
+use glam::Vec3;
+
+use crate::description::{LightSpec, SceneDescription};
+use crate::error::{Error, Result};
+
+/// The angular diameter of a distant light where none is given: the sun's.
+const DEFAULT_ANGLE_DEGREES: f32 = 0.53;
+/// A sphere light's radius where none is given (UsdLux's fallback).
+const DEFAULT_SPHERE_RADIUS: f32 = 0.5;
+/// The layer of sphere and spot lights with no name or group.
+const DEFAULT_LOCAL_GROUP: &str = "lights";
+
+/// The kinds of `[[light]]`.
+const KINDS: [&str; 5] = ["distant", "sphere", "point", "spot", "dome"];
+
+/// The keys each kind takes besides `type`, `name`, `group`, `color`,
+/// `intensity` and `exposure`.
+fn keys_of(kind: &str) -> &'static [&'static str] {
+    match kind {
+        "distant" => &["direction", "angle"],
+        "sphere" => &["position", "radius", "normalize"],
+        "point" => &["position"],
+        "spot" => &[
+            "position",
+            "direction",
+            "radius",
+            "normalize",
+            "cone_angle",
+            "cone_softness",
+        ],
+        _ => &["map", "rotation"],
+    }
+}
+
+impl LightSpec {
+    /// What the light is called in messages: its number (from 1), and
+    /// its name where it has one.
+    fn label(&self, i: usize) -> String {
+        match &self.name {
+            Some(name) => format!("light {} ({name:?})", i + 1),
+            None => format!("light {}", i + 1),
+        }
+    }
+
+    /// The keys given, by their names in the file.
+    fn given(&self) -> Vec<&'static str> {
+        let present = [
+            ("position", self.position.is_some()),
+            ("direction", self.direction.is_some()),
+            ("radius", self.radius.is_some()),
+            ("normalize", self.normalize.is_some()),
+            ("angle", self.angle.is_some()),
+            ("cone_angle", self.cone_angle.is_some()),
+            ("cone_softness", self.cone_softness.is_some()),
+            ("map", self.map.is_some()),
+            ("rotation", self.rotation.is_some()),
+        ];
+        present.iter().filter(|p| p.1).map(|p| p.0).collect()
+    }
+
+    /// Checks the light on its own: its kind, the keys its kind takes,
+    /// and every value finite and in range.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        let kind = self.kind.as_str();
+        if !KINDS.contains(&kind) {
+            let hint = if matches!(kind, "rect" | "disk" | "cylinder") {
+                " (area lights are not rendered yet)"
+            } else {
+                ""
+            };
+            return Err(format!(
+                "unknown type {kind:?}{hint}; one of {}",
+                KINDS.join(", ")
+            ));
+        }
+        let takes = keys_of(kind);
+        if let Some(key) = self.given().into_iter().find(|k| !takes.contains(k)) {
+            return Err(format!("`{key}` does not apply to a {kind} light"));
+        }
+        let finite = |key: &str, v: &[f32]| {
+            if v.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err(format!("`{key}` is not finite: {v:?}"))
+            }
+        };
+        let at_least_zero = |key: &str, v: &[f32]| {
+            finite(key, v)?;
+            if v.iter().all(|&x| x >= 0.0) {
+                Ok(())
+            } else {
+                Err(format!("`{key}` is negative: {v:?}"))
+            }
+        };
+        at_least_zero("intensity", &[self.intensity.unwrap_or(1.0)])?;
+        at_least_zero("color", &self.color.unwrap_or([1.0; 3]))?;
+        finite("exposure", &[self.exposure.unwrap_or(0.0)])?;
+        if let Some(p) = self.position {
+            finite("position", &p)?;
+        }
+        if let Some(r) = self.radius {
+            at_least_zero("radius", &[r])?;
+        }
+        if let Some(a) = self.angle {
+            at_least_zero("angle", &[a])?;
+        }
+        if let Some(r) = self.rotation {
+            finite("rotation", &[r])?;
+        }
+        if let Some(d) = self.direction {
+            finite("direction", &d)?;
+            if Vec3::from_array(d).length_squared() == 0.0 {
+                return Err("`direction` is zero".into());
+            }
+        }
+        match kind {
+            "distant" if self.direction.is_none() => {
+                Err("a distant light needs `direction`".into())
+            }
+            "sphere" | "point" | "spot" if self.position.is_none() => {
+                Err(format!("a {kind} light needs `position`"))
+            }
+            "spot" if self.direction.is_none() => Err("a spot light needs `direction`".into()),
+            "spot" => {
+                let angle = self.cone_angle.ok_or("a spot light needs `cone_angle`")?;
+                if !(angle > 0.0 && angle <= 180.0) {
+                    return Err(format!(
+                        "`cone_angle` {angle} is not in (0, 180] degrees (the half-angle off the axis)"
+                    ));
+                }
+                let soft = self.cone_softness.unwrap_or(0.0);
+                if !(0.0..=1.0).contains(&soft) {
+                    return Err(format!("`cone_softness` {soft} is not in [0, 1]"));
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// `intensity * 2^exposure * color`.
+    fn strength(&self) -> Vec3 {
+        let scale = self.intensity.unwrap_or(1.0) * self.exposure.unwrap_or(0.0).exp2();
+        Vec3::from_array(self.color.unwrap_or([1.0; 3])) * scale
+    }
+
+    /// The light-group layer its light goes to.
+    fn group_name(&self) -> &str {
+        if let Some(g) = self.group.as_deref().or(self.name.as_deref()) {
+            return g;
+        }
+        match self.kind.as_str() {
+            "distant" => DEFAULT_LIGHT_GROUPS[0],
+            "dome" => DEFAULT_LIGHT_GROUPS[1],
+            _ => DEFAULT_LOCAL_GROUP,
+        }
+    }
+
+    /// The renderer's light (checked by [`Self::check`]); a dome's map is
+    /// read here.
+    fn light(&self) -> Result<Light> {
+        let strength = self.strength();
+        let v3 = |v: Option<[f32; 3]>| Vec3::from_array(v.unwrap_or_default());
+        Ok(match self.kind.as_str() {
+            "distant" => Sun::new(
+                v3(self.direction),
+                strength,
+                self.angle.unwrap_or(DEFAULT_ANGLE_DEGREES).to_radians(),
+            )
+            .into(),
+            "dome" => match &self.map {
+                None => Environment::new(strength).into(),
+                Some(path) => {
+                    let map = EnvMap::read_exr(path, self.rotation.unwrap_or(0.0))?;
+                    Environment::from_map(Arc::new(map), strength).into()
+                }
+            },
+            kind => {
+                let default_radius = if kind == "sphere" {
+                    DEFAULT_SPHERE_RADIUS
+                } else {
+                    0.0
+                };
+                let r = self.radius.unwrap_or(default_radius);
+                let light = SphereLight::new(v3(self.position), r, intensity(strength, r, self));
+                match kind {
+                    "spot" => light.with_spot(Spot::new(
+                        v3(self.direction),
+                        self.cone_angle.unwrap_or(180.0).to_radians(),
+                        self.cone_softness.unwrap_or(0.0),
+                    )),
+                    _ => light,
+                }
+                .into()
+            }
+        })
+    }
+}
+
+/// The radiant intensity of a sphere of radius `r` whose strength is
+/// `strength`: its radiance (over its area where normalised) times its
+/// projected area `pi r^2`; a point's strength is its intensity.
+fn intensity(strength: Vec3, r: f32, spec: &LightSpec) -> Vec3 {
+    if r <= 0.0 {
+        return strength;
+    }
+    let radiance = if spec.normalize.unwrap_or(false) {
+        strength / (4.0 * PI * r * r)
+    } else {
+        strength
+    };
+    radiance * (PI * r * r)
+}
+
+/// The light-group layers of `desc`: `sun`, `sky` and `emission`, then
+/// each other group its lights name, in order.
+pub fn light_group_names(desc: &SceneDescription) -> Result<Vec<String>> {
+    let mut names: Vec<String> = DEFAULT_LIGHT_GROUPS.iter().map(|s| s.to_string()).collect();
+    for spec in &desc.lights {
+        let g = spec.group_name();
+        if !names.iter().any(|n| n == g) {
+            names.push(g.to_string());
+        }
+    }
+    if names.len() > MAX_LIGHT_GROUPS {
+        return Err(Error::input(format!(
+            "{} light groups ({}); at most {MAX_LIGHT_GROUPS}: give lights a shared `group`",
+            names.len(),
+            names.join(", ")
+        )));
+    }
+    Ok(names)
+}
+
+/// The lights of `desc`, each tagged with its light group's index in
+/// [`light_group_names`]; black lights pruned. Without `[[light]]` the
+/// sun and sky are there unless switched off; with any, only where their
+/// tables (or flags) are given.
+pub fn lights(desc: &SceneDescription) -> Result<Lights> {
+    let names = light_group_names(desc)?;
+    let index = |g: &str| names.iter().position(|n| n == g).unwrap_or(0) as u8;
+    let shorthand = desc.lights.is_empty();
+    let mut list: Vec<(Light, u8)> = Vec::new();
+    let sun = desc
+        .sun
+        .clone()
+        .or_else(|| shorthand.then(Default::default));
+    if let Some(sun) = sun.filter(|s| s.sun()) {
+        let light = Sun::new(
+            Vec3::from_array(sun.sun_dir()),
+            Vec3::from_array(sun.sun_irradiance()),
+            sun.sun_angle().to_radians(),
+        );
+        list.push((light.into(), index(DEFAULT_LIGHT_GROUPS[0])));
+    }
+    let env = desc
+        .environment
+        .clone()
+        .or_else(|| shorthand.then(Default::default));
+    if let Some(env) = env {
+        let light = match &env.env_map {
+            None => Environment::new(Vec3::from_array(env.env_radiance())),
+            Some(path) => {
+                let map = EnvMap::read_exr(path, env.env_rotation())?;
+                Environment::from_map(Arc::new(map), Vec3::splat(env.env_intensity()))
+            }
+        };
+        list.push((light.into(), index(DEFAULT_LIGHT_GROUPS[1])));
+    }
+    for spec in &desc.lights {
+        list.push((spec.light()?, index(spec.group_name())));
+    }
+    Ok(Lights::grouped(list, index(DEFAULT_LIGHT_GROUPS[2])).pruned())
+}
+
+/// Checks every `[[light]]` of a description, naming the light.
+pub(crate) fn check_all(lights: &[LightSpec]) -> std::result::Result<(), String> {
+    for (i, spec) in lights.iter().enumerate() {
+        spec.check()
+            .map_err(|e| format!("{}: {e}", spec.label(i)))?;
+    }
+    Ok(())
+}
+
+/// Each dome map's path relative to `dir`, as a scene file's are.
+pub(crate) fn rebase(lights: &mut [LightSpec], dir: &Path) {
+    for map in lights.iter_mut().filter_map(|l| l.map.as_mut()) {
+        *map = dir.join(&*map);
+    }
+}
