@@ -67,7 +67,7 @@ pub fn settings_table() -> String {
     );
     for s in crate::settings() {
         let table = match s.table {
-            "volume" => "[[volume]]".to_string(),
+            "volume" | "light" => format!("[[{}]]", s.table),
             t => format!("[{t}]"),
         };
         let code = |x: &str| format!("`{x}`");

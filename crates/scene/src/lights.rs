@@ -238,19 +238,24 @@ fn intensity(strength: Vec3, r: f32, spec: &LightSpec) -> Vec3 {
 /// The light-group layers of `desc`: `sun`, `sky` and `emission`, then
 /// each other group its lights name, in order.
 pub fn light_group_names(desc: &SceneDescription) -> Result<Vec<String>> {
+    group_names(&desc.lights).map_err(Error::input)
+}
+
+/// [`light_group_names`] of `lights`; more than the film keeps is an error.
+fn group_names(lights: &[LightSpec]) -> std::result::Result<Vec<String>, String> {
     let mut names: Vec<String> = DEFAULT_LIGHT_GROUPS.iter().map(|s| s.to_string()).collect();
-    for spec in &desc.lights {
+    for spec in lights {
         let g = spec.group_name();
         if !names.iter().any(|n| n == g) {
             names.push(g.to_string());
         }
     }
     if names.len() > MAX_LIGHT_GROUPS {
-        return Err(Error::input(format!(
+        return Err(format!(
             "{} light groups ({}); at most {MAX_LIGHT_GROUPS}: give lights a shared `group`",
             names.len(),
             names.join(", ")
-        )));
+        ));
     }
     Ok(names)
 }
@@ -302,7 +307,7 @@ pub(crate) fn check_all(lights: &[LightSpec]) -> std::result::Result<(), String>
         spec.check()
             .map_err(|e| format!("{}: {e}", spec.label(i)))?;
     }
-    Ok(())
+    group_names(lights).map(|_| ())
 }
 
 /// Each dome map's path relative to `dir`, as a scene file's are.

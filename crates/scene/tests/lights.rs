@@ -1,0 +1,197 @@
+//! `[[light]]` tables: their units, which lights a scene then has, their
+//! light-group layers (which sum to the beauty), and bad input named by
+//! file and light.
+
+use std::path::Path;
+
+use cirrus_render::Light;
+use cirrus_scene::{Overrides, Scene, SceneDescription};
+use glam::Vec3;
+
+fn cloud() -> String {
+    format!("{}/../../data/cloud.vdb", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn scene(lights: &str) -> Scene {
+    let text = format!("[[volume]]\nfile = {:?}\n{lights}", cloud());
+    let desc = SceneDescription::parse(&text).unwrap();
+    Scene::from_description(desc, Path::new(".")).unwrap()
+}
+
+fn lights_of(text: &str) -> Vec<Light> {
+    let settings = scene(text).settings().unwrap();
+    settings.lights.iter().cloned().collect()
+}
+
+#[test]
+fn a_sphere_light_sends_its_radiance_times_its_projected_area() {
+    // Radiance 2 * 2^1 * color over the area 4 pi 0.5^2 (normalised), times
+    // the projected area pi 0.5^2: intensity 4 / 4 * color = color.
+    let lights = lights_of(
+        r#"
+        [[light]]
+        type = "sphere"
+        position = [1, 2, 3]
+        radius = 0.5
+        intensity = 2
+        exposure = 1
+        color = [1, 0.5, 0.25]
+        normalize = true
+        "#,
+    );
+    assert_eq!(lights.len(), 1, "no default sun or sky beside a [[light]]");
+    let Light::Sphere(s) = &lights[0] else {
+        panic!("{:?}", lights[0])
+    };
+    assert!(
+        (s.intensity() - Vec3::new(1.0, 0.5, 0.25))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    assert_eq!(s.position(), Vec3::new(1.0, 2.0, 3.0));
+    // Unnormalised, the same numbers are the radiance: 4 color, times pi / 4.
+    let lights = lights_of(
+        "[[light]]\ntype = \"sphere\"\nposition = [0, 0, 0]\nradius = 0.5\nintensity = 4\n",
+    );
+    let Light::Sphere(s) = &lights[0] else {
+        panic!()
+    };
+    assert!((s.intensity().x - std::f32::consts::PI).abs() < 1e-5);
+    // A point's strength is its intensity.
+    let lights = lights_of("[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = 3\n");
+    let Light::Sphere(s) = &lights[0] else {
+        panic!()
+    };
+    assert!(s.is_point());
+    assert_eq!(s.intensity(), Vec3::splat(3.0));
+}
+
+#[test]
+fn the_sun_and_sky_join_lights_only_where_given() {
+    assert_eq!(lights_of("").len(), 2, "the default sun and sky");
+    let lights = lights_of(
+        r#"
+        [sun]
+        direction = [0, -1, 0]
+        [[light]]
+        type = "distant"
+        direction = [1, -1, 0]
+        intensity = 0.1
+        angle = 0.5
+        [[light]]
+        type = "dome"
+        intensity = 0.2
+        "#,
+    );
+    let kinds: Vec<_> = lights.iter().map(Light::kind).collect();
+    use cirrus_render::LightKind::{Distant, Dome};
+    assert_eq!(kinds, [Distant, Distant, Dome]);
+}
+
+#[test]
+fn light_groups_are_named_by_light_and_sum_to_the_beauty() {
+    let mut s = scene(
+        r#"
+        [environment]
+        radiance = [0.1, 0.12, 0.2]
+        [[light]]
+        type = "point"
+        name = "lamp"
+        position = [150, 160, 50]
+        intensity = 4000
+        [[light]]
+        type = "spot"
+        group = "lamp"
+        position = [150, 200, 50]
+        direction = [0, -1, 0]
+        cone_angle = 30
+        cone_softness = 0.2
+        intensity = 8000
+        [[light]]
+        type = "sphere"
+        position = [150, 80, -40]
+        radius = 5
+        intensity = 3
+        "#,
+    );
+    s.apply(&Overrides {
+        res: Some((24, 16)),
+        spp: Some(4),
+        light_groups: Some(true),
+        ..Default::default()
+    });
+    let out = s.render().unwrap();
+    let layers = out.layers.as_ref().unwrap();
+    assert_eq!(
+        layers.group_names,
+        ["sun", "sky", "emission", "lamp", "lights"]
+    );
+    let c = &out.stats.counters;
+    assert!(c.nee_rays_sphere > 0 && c.nee_rays_distant == 0, "{c:?}");
+    let (mut lamp, mut sky) = (0.0f64, 0.0f64);
+    for (i, px) in out.image.rgba.iter().enumerate() {
+        for ch in 0..3 {
+            let sum: f32 = layers.groups.iter().map(|g| g[i][ch]).sum();
+            assert!(
+                (sum - px[ch]).abs() <= 1e-5 * px[ch].abs().max(1.0),
+                "pixel {i} channel {ch}: groups {sum} vs beauty {}",
+                px[ch]
+            );
+        }
+        lamp += layers.groups[3][i][1] as f64;
+        sky += layers.groups[1][i][1] as f64;
+        assert_eq!(layers.groups[0][i], [0.0; 3], "no sun");
+    }
+    assert!(lamp > 0.0 && sky > 0.0, "lamp {lamp} sky {sky}");
+}
+
+/// The error `text` (a scene file's lights) gives, read from a file.
+fn error_of(lights: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("cirrus-lights-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, lights).unwrap();
+    let e = Scene::load(&path)
+        .err()
+        .unwrap_or_else(|| panic!("no error from {lights}"))
+        .to_string();
+    assert!(e.contains("bad.toml"), "{e}");
+    e
+}
+
+#[test]
+fn bad_lights_are_errors_naming_the_file_and_the_light() {
+    let lamp = "[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\n[[light]]\nname = \"lamp\"\n";
+    for (body, says) in [
+        ("type = \"point\"\nposition = [0, 0, 0]\nintensity = -1", "`intensity` is negative"),
+        ("type = \"sphere\"\nposition = [0, 0, 0]\nradius = -0.1", "`radius` is negative"),
+        ("type = \"point\"\nposition = [0, nan, 0]", "`position` is not finite"),
+        ("type = \"point\"", "needs `position`"),
+        ("type = \"distant\"\ndirection = [0, 0, 0]", "`direction` is zero"),
+        (
+            "type = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\ncone_angle = 200",
+            "`cone_angle` 200 is not in (0, 180]",
+        ),
+        (
+            "type = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\ncone_angle = 20\ncone_softness = 2",
+            "`cone_softness` 2 is not in [0, 1]",
+        ),
+        ("type = \"rect\"", "area lights are not rendered yet"),
+        ("type = \"lamp\"", "unknown type \"lamp\""),
+        ("type = \"distant\"\ndirection = [0, -1, 0]\nradius = 1", "`radius` does not apply to a distant light"),
+        ("type = \"point\"\nposition = [0, 0, 0]\ncolor = [1, -1, 1]", "`color` is negative"),
+    ] {
+        let e = error_of(&format!("{lamp}{body}\n"));
+        assert!(e.contains("light 2 (\"lamp\")"), "{e}");
+        assert!(e.contains(says), "{e} (expected {says:?})");
+    }
+    let many: String = (0..6)
+        .map(|i| format!("[[light]]\ntype = \"point\"\nname = \"l{i}\"\nposition = [0, 0, 0]\n"))
+        .collect();
+    let e = error_of(&format!("[[volume]]\nfile = {:?}\n{many}", cloud()));
+    assert!(
+        e.contains("9 light groups") && e.contains("shared `group`"),
+        "{e}"
+    );
+}
