@@ -274,3 +274,119 @@ def test_a_moving_transform_blurs_as_the_average_of_its_instants(camera_moves):
     print("blur vs instants:", np.round(z_avg, 2), "blur vs still:", np.round(z_still, 2), sep="\n")
     assert np.abs(z_avg).max() < 5.0
     assert np.abs(z_still).max() > 8.0
+
+
+def down_matrix(at) -> Gf.Matrix4d:
+    """A light at `at` turned so its -Z points down (-Y), exactly."""
+    return Gf.Matrix4d(1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, at[0], at[1], at[2], 1)
+
+
+def author_lights(d: Path) -> Path:
+    """The cloud lit by every light kind the reader takes: a sun, a moon (a
+    second distant light), a sphere light moved and scaled, and a point
+    spot shaped by UsdLux's ShapingAPI, turned to point down."""
+    from pxr import UsdLux
+
+    d.mkdir(parents=True, exist_ok=True)
+    shutil.copy(us.CLOUD, d / "cloud.vdb")
+    stage = us.new_stage(d / "lights.usda")
+    mat = us.material(stage)
+    us.cloud_volume(stage, "/Cloud", "./cloud.vdb", mat)
+    sun = UsdLux.DistantLight.Define(stage, "/Lights/Sun")
+    sun.CreateIntensityAttr(3.0)
+    sun.CreateNormalizeAttr(True)
+    sun.AddTransformOp().Set(sun_matrix())
+    moon = UsdLux.DistantLight.Define(stage, "/Lights/Moon")
+    moon.CreateIntensityAttr(0.4)
+    moon.CreateNormalizeAttr(True)
+    moon.CreateAngleAttr(0.5)
+    moon.AddTransformOp().Set(down_matrix((0.0, 0.0, 0.0)))
+    bulb = UsdLux.SphereLight.Define(stage, "/Lights/Bulb")
+    bulb.CreateRadiusAttr(4.0)
+    bulb.CreateIntensityAttr(3.0)
+    bulb.CreateExposureAttr(1.0)
+    bulb.CreateColorAttr(Gf.Vec3f(1.0, 0.6, 0.3))
+    UsdGeom.XformCommonAPI(bulb.GetPrim()).SetTranslate(Gf.Vec3d(140.0, 90.0, 20.0))
+    UsdGeom.XformCommonAPI(bulb.GetPrim()).SetScale(Gf.Vec3f(2.0, 2.0, 2.0))
+    lamp = UsdLux.SphereLight.Define(stage, "/Lights/Lamp")
+    lamp.CreateRadiusAttr(0.5)
+    lamp.CreateTreatAsPointAttr(True)
+    lamp.CreateIntensityAttr(60000.0)
+    shaping = UsdLux.ShapingAPI.Apply(lamp.GetPrim())
+    shaping.CreateShapingConeAngleAttr(25.0)
+    shaping.CreateShapingConeSoftnessAttr(0.3)
+    lamp.AddTransformOp().Set(down_matrix((110.0, 200.0, 60.0)))
+    us.camera(stage)
+    us.render_settings(stage, res=(RES, RES))
+    stage.GetRootLayer().Save()
+    return d / "lights.usda"
+
+
+def lights_twin(d: Path) -> dict:
+    """The TOML scene of `author_lights`, its lights' numbers from usd-core."""
+    stage = Usd.Stage.Open(str(d / "lights.usda"))
+    world = lambda p: UsdGeom.Xformable(stage.GetPrimAtPath(p)).ComputeLocalToWorldTransform(0)  # noqa: E731
+    cam = world("/Cam")
+    sun = sun_matrix()
+    moon = world("/Lights/Moon").TransformDir(Gf.Vec3d(0, 0, -1))
+    bulb = world("/Lights/Bulb")
+    lamp = world("/Lights/Lamp")
+    axis = lamp.TransformDir(Gf.Vec3d(0, 0, -1))
+    scale = sum(bulb.TransformDir(Gf.Vec3d(*e)).GetLength() for e in ((1, 0, 0), (0, 1, 0), (0, 0, 1))) / 3
+    return {
+        "camera": {
+            "res": f"{RES}x{RES}",
+            "matrix": us.rows(cam),
+            "focal_length": 35.0,
+            "horizontal_aperture": 24.0,
+            "vertical_aperture": 24.0,
+            "clipping": [1.0, 100000.0],
+        },
+        "sun": {"direction": [-sun[2][0], -sun[2][1], -sun[2][2]], "irradiance": [3.0] * 3, "angle": 0.53},
+        "environment": {"radiance": [0.0, 0.0, 0.0]},
+        "light": [
+            {"type": "distant", "name": "Moon", "direction": list(moon), "color": [0.4] * 3, "angle": 0.5},
+            {
+                "type": "sphere",
+                "name": "Bulb",
+                "position": list(bulb.Transform(Gf.Vec3d(0, 0, 0))),
+                "radius": float(F32(4.0 * scale)),
+                "color": [float(F32(6.0 * c)) for c in (1.0, F32(0.6), F32(0.3))],
+                "normalize": False,
+            },
+            {
+                "type": "spot",
+                "name": "Lamp",
+                "position": list(lamp.Transform(Gf.Vec3d(0, 0, 0))),
+                "radius": 0.0,
+                # A point of the sphere's own intensity: 60000 pi 0.5^2.
+                "color": [float(F32(60000.0 * math.pi * 0.25))] * 3,
+                "direction": list(axis),
+                "cone_angle": 25.0,
+                "cone_softness": float(F32(0.3)),
+            },
+        ],
+        "volume": [
+            {
+                "file": str(d / "cloud.vdb"),
+                "density": "density",
+                "density_scale": f32(us.DENSITY),
+                "albedo": [f32(c) for c in us.ALBEDO],
+                "g": us.G,
+            }
+        ],
+    }
+
+
+def test_every_light_kind_renders_as_its_toml_twin_bit_for_bit(tmp_path):
+    stage = author_lights(tmp_path)
+    usd = render(stage)
+    twin = render(lights_twin(tmp_path))
+    assert usd[..., :3].mean() > 0.0
+    assert np.array_equal(usd, twin)
+    # And each light matters: without the lamp (its intensity zeroed in a
+    # copy) the image changes.
+    stage_ = Usd.Stage.Open(str(stage))
+    stage_.GetPrimAtPath("/Lights/Lamp").GetAttribute("inputs:intensity").Set(0.0)
+    stage_.GetRootLayer().Export(str(tmp_path / "no_lamp.usda"))
+    assert not np.array_equal(render(tmp_path / "no_lamp.usda"), usd)

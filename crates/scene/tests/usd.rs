@@ -98,7 +98,10 @@ fn a_volume_its_material_and_transform_are_read() {
     // lights make another.
     let w = scene.warnings().join("\n");
     assert!(w.contains("inputs:roughness"), "{w}");
-    assert!(w.contains("no DistantLight or DomeLight"), "{w}");
+    assert!(
+        w.contains("no DistantLight, DomeLight or SphereLight"),
+        "{w}"
+    );
 }
 
 #[test]
@@ -323,4 +326,102 @@ fn mutated_stages_fail_cleanly_or_render() {
         refused > 0 && loaded > 0,
         "{loaded} loaded, {refused} refused"
     );
+}
+
+#[test]
+fn every_light_of_a_stage_is_read_with_its_transform_and_shaping() {
+    let d = dir("lights");
+    let lights = r#"
+    def DistantLight "Sun"
+    {
+        float inputs:intensity = 2
+        bool inputs:normalize = 1
+    }
+    def DistantLight "Moon"
+    {
+        float inputs:intensity = 0.25
+        bool inputs:normalize = 1
+        float inputs:angle = 0.5
+        float3 xformOp:rotateXYZ = (90, 0, 0)
+        uniform token[] xformOpOrder = ["xformOp:rotateXYZ"]
+    }
+    def SphereLight "Bulb"
+    {
+        float inputs:radius = 0.5
+        float inputs:intensity = 8
+        float inputs:exposure = 1
+        color3f inputs:color = (1, 0.5, 0.25)
+        double3 xformOp:translate = (10, 20, 30)
+        float3 xformOp:scale = (2, 2, 2)
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:scale"]
+    }
+    def SphereLight "Lamp" (
+        prepend apiSchemas = ["ShapingAPI"]
+    )
+    {
+        float inputs:radius = 0.5
+        bool inputs:normalize = 1
+        bool treatAsPoint = 1
+        float inputs:intensity = 100
+        float inputs:shaping:cone:angle = 30
+        float inputs:shaping:cone:softness = 0.25
+        float inputs:shaping:focus = 1
+        double3 xformOp:translate = (0, 50, 0)
+        float3 xformOp:rotateXYZ = (-90, 0, 0)
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ"]
+    }
+"#;
+    let body = format!("{}{lights}", volume("Cloud", "./cloud.vdb", "density"));
+    let p = write(&d, "shot.usda", &stage(&body));
+    let mut scene = Scene::load(&p).unwrap();
+    let w = scene.warnings().join("\n");
+    assert!(
+        w.contains("/World/Lamp: shaping:focus is not applied"),
+        "{w}"
+    );
+    assert!(!w.contains("not rendered"), "{w}");
+    let desc = scene.description();
+    assert_eq!(desc.sun.as_ref().unwrap().sun_irradiance, Some([2.0; 3]));
+    let l = &desc.lights;
+    assert_eq!(l.len(), 3, "{l:?}");
+    // The moon: -Z turned 90 degrees about X points along +Y.
+    assert_eq!(
+        (l[0].kind.as_str(), l[0].name.as_deref()),
+        ("distant", Some("Moon"))
+    );
+    let dir = l[0].direction.unwrap();
+    assert!(
+        (dir[1] - 1.0).abs() < 1e-6 && dir[2].abs() < 1e-6,
+        "{dir:?}"
+    );
+    assert_eq!(l[0].color, Some([0.25; 3]));
+    assert_eq!(l[0].angle, Some(0.5));
+    // The bulb: radiance 8 * 2 * colour, radius scaled by 2.
+    assert_eq!(l[1].kind, "sphere");
+    assert_eq!(l[1].position, Some([10.0, 20.0, 30.0]));
+    assert_eq!(l[1].radius, Some(1.0));
+    assert_eq!(l[1].color, Some([16.0, 8.0, 4.0]));
+    assert_eq!(l[1].normalize, Some(false));
+    // The lamp: a point spot of the normalised sphere's intensity, 100 / 4,
+    // its axis -Z turned -90 degrees about X: down.
+    assert_eq!(l[2].kind, "spot");
+    assert_eq!(l[2].radius, Some(0.0));
+    assert_eq!(l[2].color, Some([25.0; 3]));
+    let axis = l[2].direction.unwrap();
+    assert!((axis[1] + 1.0).abs() < 1e-6, "{axis:?}");
+    assert_eq!(
+        (l[2].cone_angle, l[2].cone_softness),
+        (Some(30.0), Some(0.25))
+    );
+    // It renders, lamp and bulb and moon in their own layers.
+    scene.apply(&Overrides {
+        res: Some((8, 8)),
+        spp: Some(1),
+        light_groups: Some(true),
+        ..Default::default()
+    });
+    let out = scene.render().unwrap();
+    let names = &out.layers.as_ref().unwrap().group_names;
+    assert_eq!(names[3..], ["Moon", "Bulb", "Lamp"]);
+    assert!(out.stats.counters.nee_rays_sphere > 0);
 }

@@ -1,4 +1,7 @@
-//! `UsdLuxDistantLight` as the sun and `UsdLuxDomeLight` as the sky.
+//! UsdLux lights: the first `DistantLight` as the sun and the first
+//! `DomeLight` as the sky (the `[sun]` and `[environment]` tables), every
+//! other distant and dome light and every `SphereLight` (a spot where its
+//! `shaping:cone:angle` is authored) as a `[[light]]`.
 //!
 //! Emission is `intensity x 2^exposure x color` (UsdLux). A distant light's
 //! irradiance (what cirrus's sun is given in) is that value when
@@ -7,11 +10,18 @@
 //! `texture:file` is a lat-long EXR in OpenEXR's layout, which is cirrus's
 //! (row 0 up +Y, column 0 toward -Z, u toward +X); the dome's rotation
 //! about +Y turns it. Unauthored inputs take UsdLux's fallbacks.
+//!
+//! A sphere light's radiance is `intensity x 2^exposure x color`, over its
+//! area `4 pi r^2` where `normalize` is on; its radius is scaled by its
+//! world transform (the mean of the axes' scales). With `treatAsPoint` it
+//! is a point of the sphere's own intensity, `L pi r^2`. A spot's axis is
+//! the light's -Z; `shaping:focus` and IES profiles are named in a warning
+//! and not applied.
 
 use glam::{DVec3, Vec3};
 use openusd::usd::Prim;
 
-use crate::description::{EnvironmentSpec, SunSpec};
+use crate::description::{EnvironmentSpec, LightSpec, SunSpec};
 use crate::error::{Error, Result};
 
 use super::values::{attr_asset, attr_number, attr_text, attr_triple, value};
@@ -129,4 +139,105 @@ pub fn dome(r: &mut Reader, path: &str) -> Result<EnvironmentSpec> {
         env_rotation: Some(rotation),
         ..Default::default()
     })
+}
+
+/// A `[[light]]` named `name` of the distant light at `path` (its sun
+/// table's numbers).
+pub fn extra_distant(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
+    let sun = distant(r, path)?;
+    Ok(LightSpec {
+        kind: "distant".into(),
+        name: Some(name.into()),
+        direction: sun.sun_dir,
+        color: sun.sun_irradiance,
+        angle: sun.sun_angle,
+        ..Default::default()
+    })
+}
+
+/// A `[[light]]` named `name` of the dome light at `path`.
+pub fn extra_dome(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
+    let env = dome(r, path)?;
+    Ok(LightSpec {
+        kind: "dome".into(),
+        name: Some(name.into()),
+        color: env.env_radiance,
+        intensity: env.env_intensity,
+        map: env.env_map,
+        rotation: env.env_rotation,
+        ..Default::default()
+    })
+}
+
+/// The `[[light]]` named `name` of the `SphereLight` at `path`: a sphere,
+/// a point, or either shaped into a spot.
+pub fn sphere(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
+    let p = r.stage.prim(path);
+    let t = r.time.start;
+    let strength = emission(r, path, 1.0)?;
+    let flag = |name: &str| -> Result<bool> {
+        Ok(matches!(
+            value(&p, name, t)?,
+            Some(openusd::sdf::Value::Bool(true))
+        ))
+    };
+    let normalize = flag("inputs:normalize")?;
+    let as_point = flag("treatAsPoint")?;
+    let radius = input_number(&p, "radius", t)?.unwrap_or(0.5);
+    let world = world_at(&r.stage, path, t)?;
+    let position = world.transform_point3(DVec3::ZERO);
+    let scale = (world.transform_vector3(DVec3::X).length()
+        + world.transform_vector3(DVec3::Y).length()
+        + world.transform_vector3(DVec3::Z).length())
+        / 3.0;
+    let radius = radius * scale;
+    if !position.is_finite() || !radius.is_finite() || radius < 0.0 {
+        return Err(r.error(
+            path,
+            format!("position {position} and radius {radius} must be finite, the radius >= 0"),
+        ));
+    }
+    let mut spec = LightSpec {
+        kind: "sphere".into(),
+        name: Some(name.into()),
+        position: Some(position.as_vec3().to_array()),
+        ..Default::default()
+    };
+    if as_point {
+        // A point sending what the sphere sends: its radiance times its
+        // projected area.
+        let area = std::f64::consts::PI * radius * radius;
+        let area_scale = if normalize { 0.25 } else { area };
+        spec.kind = "point".into();
+        spec.color = Some((strength.as_dvec3() * area_scale).as_vec3().to_array());
+    } else {
+        spec.radius = Some(radius as f32);
+        spec.color = Some(strength.to_array());
+        spec.normalize = Some(normalize);
+    }
+    if let Some(angle) = input_number(&p, "shaping:cone:angle", t)? {
+        let softness = input_number(&p, "shaping:cone:softness", t)?.unwrap_or(0.0);
+        let axis = world.transform_vector3(DVec3::NEG_Z);
+        if !axis.is_finite() || axis.length() < 1e-12 {
+            return Err(r.error(path, "the light's transform gives its cone no axis"));
+        }
+        if !(angle > 0.0 && angle <= 180.0) || !(0.0..=1.0).contains(&softness) {
+            return Err(r.error(
+                path,
+                format!("cone angle {angle} must be in (0, 180] and softness {softness} in [0, 1]"),
+            ));
+        }
+        spec.kind = "spot".into();
+        spec.radius = Some(if as_point { 0.0 } else { radius as f32 });
+        spec.direction = Some(axis.as_vec3().to_array());
+        spec.cone_angle = Some(angle as f32);
+        spec.cone_softness = Some(softness as f32);
+    }
+    if input_number(&p, "shaping:focus", t)?.is_some_and(|f| f != 0.0) {
+        r.warn(format!("{path}: shaping:focus is not applied"));
+    }
+    if attr_asset(&p, "inputs:shaping:ies:file", t)?.is_some() {
+        r.warn(format!("{path}: an IES profile is not applied"));
+    }
+    Ok(spec)
 }

@@ -12,7 +12,7 @@
 //!   with its world transform (composed through its parents, instance
 //!   proxies included: each instance of a prototype is its own volume) and
 //!   bound material (`material.rs`);
-//! - `DistantLight` as the sun and `DomeLight` as the sky (`lights.rs`);
+//! - every `DistantLight`, `DomeLight` and `SphereLight` (`lights.rs`);
 //! - the camera the `RenderSettings` name, else the first `Camera`, and the
 //!   settings' resolution (`camera.rs`);
 //! - time: the stage's `startTimeCode`-`endTimeCode` become the frames
@@ -218,6 +218,7 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
                     "DistantLight",
                     "DomeLight",
                     "DomeLight_1",
+                    "SphereLight",
                     "Camera",
                     "RenderSettings",
                 ]
@@ -227,7 +228,7 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
         .collect();
     if !unsupported.is_empty() {
         r.warn(format!(
-            "{}: not rendered (cirrus renders volumes, a distant light, a dome light and a camera): {}",
+            "{}: not rendered (cirrus renders volumes, distant, dome and sphere lights and a camera): {}",
             r.file,
             unsupported.join(", ")
         ));
@@ -246,6 +247,7 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
         r,
         &of(&["DistantLight"]),
         &of(&["DomeLight", "DomeLight_1"]),
+        &of(&["SphereLight"]),
         &mut desc,
     )?;
     view(r, &of(&["Camera"]), &of(&["RenderSettings"]), &mut desc)?;
@@ -261,21 +263,17 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
 
 /// The first distant light is the sun, the first dome the sky; a stage
 /// without one has none (no default sun or sky is added).
+/// The first distant light as the sun and the first dome as the sky (none
+/// where the stage has none), every other light as a `[[light]]` named
+/// by its prim; where their names would make more light-group layers than
+/// the film keeps, they share their kinds' layers instead.
 fn lights(
     r: &mut Reader,
     suns: &[String],
     domes: &[String],
+    spheres: &[String],
     desc: &mut SceneDescription,
 ) -> Result<()> {
-    for (kind, extra) in [("DistantLight", suns), ("DomeLight", domes)] {
-        if extra.len() > 1 {
-            r.warn(format!(
-                "{}: only the first {kind} is rendered; not rendered: {}",
-                r.file,
-                extra[1..].join(", ")
-            ));
-        }
-    }
     desc.sun = Some(match suns.first() {
         Some(p) => lights::distant(r, p)?,
         None => SunSpec {
@@ -290,9 +288,36 @@ fn lights(
             ..Default::default()
         },
     });
-    if suns.is_empty() && domes.is_empty() {
+    let name = |path: &str| path.rsplit('/').next().unwrap_or(path).to_string();
+    for p in suns.iter().skip(1) {
+        desc.lights.push(lights::extra_distant(r, p, &name(p))?);
+    }
+    for p in domes.iter().skip(1) {
+        desc.lights.push(lights::extra_dome(r, p, &name(p))?);
+    }
+    for p in spheres {
+        desc.lights.push(lights::sphere(r, p, &name(p))?);
+    }
+    if crate::lights::light_group_names(desc).is_err() {
         r.warn(format!(
-            "{}: the stage has no DistantLight or DomeLight: the volumes are unlit",
+            "{}: {} lights are more light-group layers than the film keeps: they share `sun`, `sky` and `lights`",
+            r.file,
+            desc.lights.len()
+        ));
+        for l in &mut desc.lights {
+            l.group = Some(
+                match l.kind.as_str() {
+                    "distant" => "sun",
+                    "dome" => "sky",
+                    _ => "lights",
+                }
+                .into(),
+            );
+        }
+    }
+    if suns.is_empty() && domes.is_empty() && spheres.is_empty() {
+        r.warn(format!(
+            "{}: the stage has no DistantLight, DomeLight or SphereLight: the volumes are unlit",
             r.file
         ));
     }
