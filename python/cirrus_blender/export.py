@@ -18,7 +18,15 @@ What is mapped:
   Blackbody maps the temperature attribute to cirrus's blackbody emission
   (approximately: cirrus emits sigma_a x Le); Emission Strength, which
   Cycles emits evenly through the object's box, is reported, not mapped;
-- sun lamps (strength is irradiance in both), the world's Background
+- lamps: every sun lamp (strength is irradiance in both; the first as
+  `[sun]`, the others as `[[light]]`), point lamps (Cycles sends a lamp
+  of power P and colour c the radiant intensity `P c / (4 pi)` in every
+  direction; its radius makes it a ball of that intensity) and spot lamps
+  (the same, in a cone of half the spot size, its edge blended over
+  `spot_blend` of the cone's `1 - cos`, as Cycles' smoothstep does), each
+  named by its object (its light-group layer); Cycles' soft falloff (on by
+  default) changes a lamp's light only near its surface, where cirrus's
+  ball is uniform; the world's Background
   colour or an equirectangular Environment Texture, and the scene camera
   (its matrix, field of view and clip range);
 - motion blur: the shutter, and the volume's velocity grid.
@@ -65,8 +73,11 @@ class Export:
                 self.volume(obj, inst.matrix_world.copy())
             elif obj.type == "LIGHT" and obj.data.type == "SUN":
                 suns.append((obj, inst.matrix_world.copy()))
+            elif obj.type == "LIGHT" and obj.data.type in ("POINT", "SPOT"):
+                self.lamp(obj, inst.matrix_world.copy())
             elif obj.type == "LIGHT":
-                self.warn(f"{obj.name}: {obj.data.type.lower()} lamps are not rendered (sun lamps are)")
+                self.warn(f"{obj.name}: {obj.data.type.lower()} lamps are not rendered "
+                          "(sun, point and spot lamps are)")
             elif obj.type == "CAMERA":
                 continue
             elif obj.type in ("EMPTY",):
@@ -211,24 +222,59 @@ class Export:
     # --- lights, world, camera ---
 
     def sun(self, suns) -> None:
+        """The first sun lamp as `[sun]`, the others as distant `[[light]]`s."""
         if not suns:
             self.desc["sun"] = {"enabled": False}
             return
-        for obj, _ in suns[1:]:
-            self.warn(f"{obj.name}: only one sun lamp is rendered ({suns[0][0].name})")
-        obj, m = suns[0]
+        for i, (obj, m) in enumerate(suns):
+            light = obj.data
+            direction = (Y_UP @ m).to_3x3() @ mathutils.Vector((0.0, 0.0, -1.0))
+            strength = float(light.energy)
+            if not getattr(light, "normalize", True) and light.angle > 0:
+                # Unnormalised, strength is the disk's radiance.
+                strength *= math.pi * math.sin(0.5 * light.angle) ** 2
+            colour = [float(c) * strength for c in light.color]
+            if i == 0:
+                self.desc["sun"] = {
+                    "direction": list(direction),
+                    "irradiance": colour,
+                    "angle": math.degrees(light.angle),
+                }
+            else:
+                self.desc.setdefault("light", []).append({
+                    "type": "distant",
+                    "name": obj.name,
+                    "direction": list(direction),
+                    "color": colour,
+                    "angle": math.degrees(light.angle),
+                })
+
+    def lamp(self, obj, m) -> None:
+        """A point or spot lamp as a `[[light]]` of Cycles' intensity."""
         light = obj.data
-        direction = (Y_UP @ m).to_3x3() @ mathutils.Vector((0.0, 0.0, -1.0))
-        strength = float(light.energy)
-        if not getattr(light, "normalize", True) and light.angle > 0:
-            # Unnormalised, strength is the disk's radiance.
-            strength *= math.pi * math.sin(0.5 * light.angle) ** 2
-        colour = [float(c) * strength for c in light.color]
-        self.desc["sun"] = {
-            "direction": list(direction),
-            "irradiance": colour,
-            "angle": math.degrees(light.angle),
-        }
+        world = Y_UP @ m
+        position = world.to_translation()
+        # Cycles takes the radius as it is, unscaled by the object.
+        radius = float(light.shadow_soft_size)
+        intensity = [float(c) * float(light.energy) / (4.0 * math.pi) for c in light.color]
+        entry: dict = {"name": obj.name, "position": list(position)}
+        if radius > 0.0:
+            # A ball of radiance I / (pi r^2) sends I.
+            entry.update({"type": "sphere", "radius": radius,
+                          "color": [i / (math.pi * radius * radius) for i in intensity]})
+        else:
+            entry.update({"type": "point", "color": intensity})
+        if light.type == "SPOT":
+            axis = world.to_3x3() @ mathutils.Vector((0.0, 0.0, -1.0))
+            entry.update({
+                "type": "spot",
+                "radius": radius,
+                "color": entry["color"],
+                "direction": list(axis.normalized()),
+                "cone_angle": math.degrees(0.5 * float(light.spot_size)),
+                "cone_softness": float(light.spot_blend),
+            })
+        self.desc.setdefault("light", []).append(entry)
 
     def world(self) -> None:
         world = self.scene.world

@@ -162,7 +162,7 @@ pub fn prepare<'c>(
         scene: cirrus_render::Scene {
             media: volumes,
             camera,
-            lights: settings.lights,
+            lights: settings.lights.relative_to(centre),
         },
         settings: settings.render,
         centre,

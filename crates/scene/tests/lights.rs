@@ -195,3 +195,47 @@ fn bad_lights_are_errors_naming_the_file_and_the_light() {
         "{e}"
     );
 }
+
+#[test]
+fn a_sphere_light_stays_where_it_is_against_the_volume_wherever_both_are() {
+    // The cloud, a lamp beside it and the camera, all moved 5000 units:
+    // render space follows the volumes, so the image is the same.
+    let text = |dx: f32| {
+        format!(
+            r#"
+            [camera]
+            res = "24x16"
+            from = [{}, 83, -250]
+            to = [{}, 83, 100]
+            [render]
+            spp = 4
+            [[light]]
+            type = "sphere"
+            position = [{}, 150, 20]
+            radius = 5
+            intensity = 200
+            [[volume]]
+            file = {:?}
+            transform = {{ translate = [{dx}, 0, 0] }}
+            "#,
+            150.0 + dx,
+            150.0 + dx,
+            260.0 + dx,
+            cloud()
+        )
+    };
+    let render = |dx: f32| {
+        let desc = SceneDescription::parse(&text(dx)).unwrap();
+        let out = Scene::from_description(desc, Path::new("."))
+            .unwrap()
+            .render()
+            .unwrap();
+        out.image.rgba.iter().map(|p| p[1] as f64).sum::<f64>()
+    };
+    let (here, there) = (render(0.0), render(5000.0));
+    assert!(here > 0.0);
+    assert!(
+        (here / there - 1.0).abs() < 1e-3,
+        "green sum {here} here, {there} moved"
+    );
+}

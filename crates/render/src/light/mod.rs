@@ -238,6 +238,18 @@ impl Lights {
         })
     }
 
+    /// The lights with positions given relative to `origin` (render space
+    /// is world space minus a centre kept in f64, so that f32 stays
+    /// precise far from the world's origin); directions are unchanged.
+    pub fn relative_to(mut self, origin: glam::DVec3) -> Self {
+        for light in &mut self.list {
+            if let Light::Sphere(s) = light {
+                *s = s.moved_to((s.position().as_dvec3() - origin).as_vec3());
+            }
+        }
+        self
+    }
+
     /// Drops lights that deliver nothing (zero irradiance or radiance), so
     /// they cost nothing either; the others keep their order and groups.
     pub fn pruned(self) -> Self {

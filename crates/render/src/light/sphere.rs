@@ -100,6 +100,11 @@ impl SphereLight {
         }
     }
 
+    /// The same light at `position`.
+    pub fn moved_to(self, position: Vec3) -> Self {
+        Self { position, ..self }
+    }
+
     pub fn position(&self) -> Vec3 {
         self.position
     }
