@@ -99,8 +99,9 @@ declare_settings! {
     /// one light picked by its in-scattered light there seen through the
     /// media (a coarse shadow grid; half the shadow rays under a sun and a
     /// sky, and few deep in a thick cloud), or to every light; `auto` picks
-    /// one under constant domes (a constant sky), every light under a map;
-    /// a scene of more than 8 lights samples every light.
+    /// one under constant domes (a constant sky), every light under a map,
+    /// and one past 8 lights, weighed by what each sends toward the vertex
+    /// (`uniform`: one picked uniformly, the baseline).
     light_sampling: LightSampling, flag(long, value_enum), default(LightSampling::default()),
         example(LightSampling::All);
     /// Sunward scattering: at each scattering vertex, also scatter toward

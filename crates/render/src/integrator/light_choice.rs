@@ -48,7 +48,10 @@
 
 use glam::Vec3;
 
-use super::per_light::{into_shares, lane_shares, lanes_of, raise_to_floors, Lanes, Shares};
+use super::many_lights::ManyLights;
+use super::per_light::{
+    into_shares, lane_shares, lanes_of, raise_to_floors, Lanes, Shares, MIN_PROBABILITY,
+};
 pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
 use crate::light::{Light, Lights, SphereLight};
 use crate::phase::Phase;
@@ -64,23 +67,28 @@ settings_enum! {
         All = "all",
         /// One light (or, deep in the media, most often none), picked in
         /// proportion to its in-scattered radiance at the vertex seen through
-        /// the media.
+        /// the media (past 8 lights, by what each sends toward the vertex:
+        /// `many_lights.rs`).
         One = "one",
+        /// One light picked uniformly at random (the baseline the weighed
+        /// pick is measured against).
+        Uniform = "uniform",
     }
 }
 
 impl LightSampling {
     /// Whether a vertex picks one light under `lights` (pruned of the dark
-    /// ones): `one`, resolved, with a sun or a sky to pick.
+    /// ones) through a shadow grid: `one`, resolved, with a light to pick
+    /// and no more than [`MAX_PICKED_LIGHTS`].
     pub fn picks_one(self, lights: &Lights) -> bool {
-        self.resolve(lights) == Self::One && !lights.is_empty()
+        self.resolve(lights) == Self::One && !lights.is_empty() && lights.len() <= MAX_PICKED_LIGHTS
     }
 
-    /// What `self` comes to under `lights`: `All` or `One` (`All` past
-    /// [`MAX_PICKED_LIGHTS`] lights).
+    /// What `self` comes to under `lights`: `All`, `One` or `Uniform`
+    /// (`auto` is `One` past [`MAX_PICKED_LIGHTS`] lights).
     pub fn resolve(self, lights: &Lights) -> LightSampling {
         match self {
-            _ if lights.len() > MAX_PICKED_LIGHTS => Self::All,
+            Self::Auto if lights.len() > MAX_PICKED_LIGHTS => Self::One,
             Self::Auto
                 if lights.domes().next().is_some() && lights.domes().all(|e| e.map.is_none()) =>
             {
@@ -137,6 +145,9 @@ pub fn disc_floor(f: f32, solid_angle: f32) -> f32 {
 pub(crate) enum LightChoice {
     /// Every light, once (probability 1 each; no number drawn).
     All,
+    /// One light among many, weighed at `at` ([`ManyLights`]), whose
+    /// weights sum to `total` there.
+    Weighed { at: Vec3, total: f32 },
     /// Each light with its probability. They may sum to less than one
     /// (the vertex then samples no light with the rest) or, where a disc's
     /// floor raised one, to more (it then sometimes samples two).
@@ -171,6 +182,9 @@ pub(crate) struct LightSampler {
     disc: Vec<f32>,
     /// 1 in the lanes of the lights, 0 past them ([`lane_shares`]).
     lanes: Lanes,
+    /// The weighing of lights past [`MAX_PICKED_LIGHTS`], or of any number
+    /// picked uniformly.
+    many: Option<ManyLights>,
     /// Per light, its weight seen from an isotropic vertex (luminance over
     /// `4 pi` for a distant light), which [`Self::facing`] gives every
     /// light but the one it asks about; empty past [`MAX_PICKED_LIGHTS`].
@@ -199,8 +213,17 @@ impl LightSampler {
                 Light::Sphere(_) => 0.0,
             };
         }
+        let sampling = sampling.resolve(lights);
+        let many = match sampling {
+            LightSampling::Uniform => Some(ManyLights::new(lights, true)),
+            LightSampling::One if lights.len() > MAX_PICKED_LIGHTS => {
+                Some(ManyLights::new(lights, false))
+            }
+            _ => None,
+        };
         Self {
-            sampling: sampling.resolve(lights),
+            sampling,
+            many,
             luminance,
             aim,
             disc,
@@ -215,10 +238,34 @@ impl LightSampler {
         self.sampling
     }
 
-    /// Whether vertices pick among the lights (`one`, and two or more).
+    /// Whether vertices pick among a few lights (`one`, and two to
+    /// [`MAX_PICKED_LIGHTS`]).
     #[inline]
     fn picks(&self) -> bool {
-        self.sampling == LightSampling::One && self.luminance.len() >= 2
+        self.sampling == LightSampling::One && self.luminance.len() >= 2 && self.many.is_none()
+    }
+
+    /// The probability that `choice` samples light `i`.
+    #[inline]
+    pub fn probability(&self, choice: &LightChoice, i: usize) -> f32 {
+        match (choice, &self.many) {
+            (LightChoice::All, _) => 1.0,
+            (LightChoice::Pick(p), _) => p[i],
+            (LightChoice::Weighed { at, total }, Some(many)) => many.probability(*at, *total, i),
+            (LightChoice::Weighed { .. }, None) => {
+                unreachable!("a weighed pick without its weights")
+            }
+        }
+    }
+
+    /// The light a weighed pick at `at` samples with `u`, and its
+    /// probability.
+    #[inline]
+    pub fn pick_weighed(&self, at: Vec3, total: f32, u: f32) -> (usize, f32) {
+        self.many
+            .as_ref()
+            .expect("a weighed pick has its weights")
+            .pick(at, total, u)
     }
 
     /// Light `i`'s unoccluded in-scattered luminance at a vertex at `p`
@@ -260,6 +307,12 @@ impl LightSampler {
     /// are lights to choose among.
     #[inline]
     pub fn at(&self, phase: &Phase, at: Vec3, dir_in: Vec3) -> LightChoice {
+        if let Some(many) = &self.many {
+            return LightChoice::Weighed {
+                at,
+                total: many.total(at),
+            };
+        }
         if !self.picks() {
             return LightChoice::All;
         }
@@ -276,6 +329,10 @@ impl LightSampler {
     /// same for both of its strategies).
     #[inline]
     pub fn facing(&self, light: usize, f: f32) -> f32 {
+        if let Some(many) = &self.many {
+            // Its defensive share: the weights need a position.
+            return MIN_PROBABILITY / many.len() as f32;
+        }
         if !self.picks() {
             return 1.0;
         }
@@ -327,15 +384,6 @@ impl LightSampler {
 }
 
 impl LightChoice {
-    /// The probability that light `i` is sampled.
-    #[inline]
-    pub fn probability(&self, i: usize) -> f32 {
-        match self {
-            Self::All => 1.0,
-            Self::Pick(p) => p[i],
-        }
-    }
-
     /// Whether `u` (uniform in [0, 1)) samples light `i`: the lights'
     /// probabilities laid end to end around the unit interval, in list
     /// order, wrapping to its start past one. Each light is sampled with
@@ -358,7 +406,6 @@ mod tests {
     use std::sync::Arc;
 
     use super::super::light_grid::LightGrid;
-    use super::super::per_light::MIN_PROBABILITY;
     use crate::env_map::EnvMap;
     use crate::light::{Environment, Sun};
     use crate::spectrum::luminance;
@@ -374,7 +421,7 @@ mod tests {
     fn probabilities(c: &LightChoice) -> &[f32] {
         match c {
             LightChoice::Pick(p) => p,
-            LightChoice::All => panic!("every light sampled"),
+            other => panic!("not a pick among a few: {other:?}"),
         }
     }
 
@@ -499,7 +546,7 @@ mod tests {
     /// one with at least its defensive share; past that it samples every
     /// light.
     #[test]
-    fn a_pick_covers_up_to_its_most_lights_and_then_every_light_is_sampled() {
+    fn a_pick_covers_up_to_its_most_lights_and_then_weighs_many() {
         let phase = Phase::hg(0.6);
         let sun = |i: usize| {
             let a = i as f32;
@@ -519,10 +566,20 @@ mod tests {
         assert!((p.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{p:?}");
         assert!(p.iter().all(|&p| p >= floor * 0.9999), "{p:?}");
         let too_many = Lights::new((0..MAX_PICKED_LIGHTS).map(sun).chain([sky()]));
-        assert_eq!(LightSampling::One.resolve(&too_many), LightSampling::All);
+        assert_eq!(LightSampling::Auto.resolve(&too_many), LightSampling::One);
+        assert!(
+            !LightSampling::One.picks_one(&too_many),
+            "no shadow grid past the most"
+        );
         let sampler = LightSampler::new(&too_many, LightSampling::One);
-        assert_eq!(sampler.at(&phase, Vec3::ZERO, Vec3::X), LightChoice::All);
-        assert_eq!(sampler.facing(0, 1.0), 1.0);
+        let c = sampler.at(&phase, Vec3::ZERO, Vec3::X);
+        assert!(matches!(c, LightChoice::Weighed { .. }), "{c:?}");
+        let sum: f32 = (0..too_many.len())
+            .map(|i| sampler.probability(&c, i))
+            .sum();
+        assert!((sum - 1.0).abs() < 1e-5, "{sum}");
+        let all = LightSampler::new(&too_many, LightSampling::All);
+        assert_eq!(all.at(&phase, Vec3::ZERO, Vec3::X), LightChoice::All);
     }
 
     /// A cube of uniform density 4 over [0, 4]^3 (optical depth 16 across),

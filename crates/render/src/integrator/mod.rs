@@ -9,6 +9,7 @@
 
 mod light_choice;
 mod light_grid;
+mod many_lights;
 mod march;
 mod path;
 mod path_flight;
@@ -35,7 +36,7 @@ use crate::light::{LightKind, Lights};
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Rng, SampleStream};
 use crate::stats::Counters;
-use light_choice::LightChoice;
+use light_choice::{LightChoice, LightSampler};
 
 settings_enum! {
     /// Which integrator renders the image.
@@ -117,15 +118,15 @@ pub trait CameraSampler: Sync {
 pub(crate) fn escaped_radiance(
     lights: &Lights,
     dir: Vec3,
-    phase_pdf: Option<(f32, &LightChoice)>,
+    phase_pdf: Option<(f32, &LightChoice, &LightSampler)>,
     c: &mut Counters,
 ) -> LightParts {
     let mut l = LightParts::default();
     for (i, light) in lights.iter().enumerate() {
         c.dome_samples += u64::from(light.kind() == LightKind::Dome);
         if let Some((radiance, pdf)) = light.escaped(dir) {
-            let weight = phase_pdf.map_or(1.0, |(p, choice)| {
-                power_heuristic(p, choice.probability(i) * pdf)
+            let weight = phase_pdf.map_or(1.0, |(p, choice, sampler)| {
+                power_heuristic(p, sampler.probability(choice, i) * pdf)
             });
             l.add(lights.group(i), radiance * weight);
         }

@@ -283,7 +283,7 @@ impl<M: Media> PathTracer<'_, M> {
         let pdf = match &path.escape {
             _ if path.emission_only || path.ray.t_max.is_finite() => return,
             Escape::Full => None,
-            Escape::Mis(pdf, choice) => Some((*pdf, choice)),
+            Escape::Mis(pdf, choice) => Some((*pdf, choice, &self.sampler)),
         };
         let parts = escaped_radiance(&self.lights, path.ray.dir, pdf, c);
         let e = path.beta * parts.total();

@@ -114,7 +114,9 @@ impl<M: Media> PathTracer<'_, M> {
         }
         let weight = match &path.escape {
             Escape::Full => 1.0,
-            Escape::Mis(pdf, choice) => power_heuristic(*pdf, choice.probability(h.light) * h.pdf),
+            Escape::Mis(pdf, choice) => {
+                power_heuristic(*pdf, self.sampler.probability(choice, h.light) * h.pdf)
+            }
         };
         let e = path.beta * h.radiance * weight;
         path.add_to_group(e, self.lights.group(h.light), self.light_groups);

@@ -36,6 +36,12 @@ impl<M: Media> PathTracer<'_, M> {
                     l.add(self.lights.group(i), e);
                 }
             }
+            LightChoice::Weighed { at, total } => {
+                let u = draws.rng().uniform();
+                let (i, p) = self.sampler.pick_weighed(*at, *total, u);
+                let e = self.light_sample::<S>(v, i, p, 0, draws, c);
+                l.add(self.lights.group(i), e);
+            }
             LightChoice::Pick(p) => {
                 // Where the probabilities sum below one the vertex samples
                 // no light with the rest; past one, sometimes two.

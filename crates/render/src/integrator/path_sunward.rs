@@ -196,9 +196,8 @@ impl<M: Media> PathTracer<'_, M> {
         // The continuation would reach `p` along `w` and pick the sun there
         // with this probability (its shadow grid's, as the continuation's
         // own vertex there computes it).
-        let pick = self
-            .light_choice(it.phase, p, w, self.seen(it.phase, p, w).as_ref())
-            .probability(light);
+        let choice = self.light_choice(it.phase, p, w, self.seen(it.phase, p, w).as_ref());
+        let pick = self.sampler.probability(&choice, light);
         let weight = sunward_weight(q, f, pick);
         let s = sun.sample(rng.uniform(), rng.uniform());
         let f_sun = it.phase.eval(w, s.to_light);

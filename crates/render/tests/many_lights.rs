@@ -1,0 +1,82 @@
+//! Past 8 lights one light is picked per vertex by what each sends toward
+//! it (`integrator/many_lights.rs`): a fog lit by a street of 16 lamps and
+//! a dim sky renders what sampling every light renders, weighed or
+//! uniform, with one shadow ray per vertex instead of 17.
+
+mod common;
+
+use cirrus_render::{
+    render, Camera, ConstantBox, Environment, IntegratorKind, Light, LightSampling, Lights, Medium,
+    Rendered, Scene, SphereLight, Volumes,
+};
+use glam::Vec3;
+
+fn street() -> Lights {
+    let lamps = (0..16).map(|k| {
+        let x = -7.5 + k as f32;
+        let at = Vec3::new(x, 1.5 + 0.3 * (k % 3) as f32, 0.5 * (k % 2) as f32);
+        let radius = if k % 4 == 0 { 0.0 } else { 0.1 };
+        let i = Vec3::new(4.0, 3.0 + 0.2 * k as f32, 2.0);
+        Light::from(SphereLight::new(at, radius, i))
+    });
+    Lights::new(lamps.chain([Environment::new(Vec3::new(0.02, 0.03, 0.05)).into()]))
+}
+
+fn render_street(sampling: LightSampling, seed: u64) -> Rendered {
+    let fog = ConstantBox::new(
+        Vec3::new(-10.0, -2.0, -3.0),
+        Vec3::new(10.0, 4.0, 3.0),
+        1.0,
+        0.25,
+    );
+    let scene = Scene {
+        media: Volumes::from(Medium::new(fog, 0.3, Vec3::splat(0.8), 0.3)),
+        camera: Camera::new(
+            Vec3::new(0.0, 0.5, -9.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::Y,
+            60.0,
+            24,
+            16,
+        ),
+        lights: street(),
+    };
+    let mut s = common::settings(IntegratorKind::Path, 64, seed);
+    s.light_sampling = sampling;
+    s.max_depth = Some(3);
+    let out = render(&scene, &s);
+    assert_eq!(out.stats.counters.nonfinite_samples, 0);
+    out
+}
+
+#[test]
+fn many_lights_picked_one_per_vertex_render_as_every_light() {
+    let all = render_street(LightSampling::All, 1);
+    let weighed = render_street(LightSampling::Auto, 2);
+    let uniform = render_street(LightSampling::Uniform, 3);
+    let rays = |r: &Rendered| r.stats.counters.nee_rays_sphere + r.stats.counters.nee_rays_dome;
+    let vertices = |r: &Rendered| r.stats.counters.real_collisions;
+    // Every light: 16 lamp rays and a sky ray a vertex (the sky's drawn
+    // toward its pole may be dropped); one picked: at most one.
+    assert!(
+        rays(&all) >= 16 * vertices(&all),
+        "{:?}",
+        all.stats.counters
+    );
+    assert!(
+        rays(&weighed) <= vertices(&weighed),
+        "{:?}",
+        weighed.stats.counters
+    );
+    assert!(
+        rays(&uniform) <= vertices(&uniform),
+        "{:?}",
+        uniform.stats.counters
+    );
+    for (label, other) in [("weighed", &weighed), ("uniform", &uniform)] {
+        for channel in 0..3 {
+            let d = common::differences(&all.image, &other.image, channel);
+            common::assert_pooled_agreement(&format!("{label}, channel {channel}"), &d);
+        }
+    }
+}
