@@ -221,7 +221,7 @@ pub fn sphere(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
         if !axis.is_finite() || axis.length() < 1e-12 {
             return Err(r.error(path, "the light's transform gives its cone no axis"));
         }
-        if !(angle > 0.0 && angle <= 180.0) || !(0.0..=1.0).contains(&softness) {
+        if !(angle > 0.0 && angle <= 180.0 && (0.0..=1.0).contains(&softness)) {
             return Err(r.error(
                 path,
                 format!("cone angle {angle} must be in (0, 180] and softness {softness} in [0, 1]"),
