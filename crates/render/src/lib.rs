@@ -85,8 +85,8 @@ pub use env_map::EnvMap;
 pub use error::{Error, Result};
 pub use film::{AovImage, Halves, Image};
 pub use integrator::{
-    AovSample, CameraSampler, IntegratorKind, LightGrid, LightGridSettings, LightSampling,
-    PathTracer, RayMarcher, Sample, Sunward, TwoPassMarcher,
+    AovSample, CameraSampler, DistanceSampling, IntegratorKind, LightGrid, LightGridSettings,
+    LightSampling, PathTracer, RayMarcher, Sample, Sunward, TwoPassMarcher,
 };
 pub use light::{Environment, Light, LightKind, Lights, SphereLight, Spot, Sun};
 pub use medium::{

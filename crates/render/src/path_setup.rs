@@ -27,6 +27,7 @@ pub(crate) fn path_tracer<'a, M: Media>(
     .with_light_groups(!settings.compositing.light_groups.is_empty())
     .with_light_sampling(settings.light_sampling)
     .with_sunward(settings.sunward)
+    .with_distance_sampling(settings.distance_sampling)
     .with_shadows(shadows.map(|s| &s.grid))
 }
 

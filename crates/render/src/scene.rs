@@ -8,8 +8,8 @@ use crate::camera::Camera;
 use crate::compositing::Compositing;
 use crate::control::RenderControl;
 use crate::error::{Error, Result};
+use crate::integrator::{DistanceSampling, LightSampling, Sunward};
 use crate::integrator::{IntegratorKind, LightGridSettings};
-use crate::integrator::{LightSampling, Sunward};
 use crate::light::Lights;
 use crate::sampling::SamplerKind;
 use crate::shutter::Shutter;
@@ -115,6 +115,9 @@ pub struct RenderSettings {
     pub light_sampling: LightSampling,
     /// Where the path tracer also scatters toward the sun ([`Sunward`]).
     pub sunward: Sunward,
+    /// How the path tracer samples where light scatters along a ray
+    /// ([`DistanceSampling`]).
+    pub distance_sampling: DistanceSampling,
 }
 
 /// A pixel window `[x0, x1) x [y0, y1)` of the camera's image.
@@ -163,6 +166,7 @@ impl Default for RenderSettings {
             compositing: Compositing::default(),
             light_sampling: LightSampling::default(),
             sunward: Sunward::default(),
+            distance_sampling: DistanceSampling::default(),
         }
     }
 }

@@ -44,6 +44,10 @@ pub struct Counters {
     /// Times a dome was consulted: directions sampled from it for
     /// next-event estimation, and escaped rays looking it up.
     pub dome_samples: u64,
+    /// Distances drawn by equi-angular sampling toward sphere lights
+    /// (`integrator/path_equiangular.rs`), each a transmittance walk and a
+    /// shadow ray.
+    pub equiangular_samples: u64,
     /// Directions drawn toward a distant light by sunward scattering
     /// (`integrator/path_sunward.rs`), each a free flight and, where it
     /// collides, a shadow ray.
@@ -68,6 +72,7 @@ impl AddAssign for Counters {
         self.nee_rays_sphere += o.nee_rays_sphere;
         self.dome_samples += o.dome_samples;
         self.sunward_rays += o.sunward_rays;
+        self.equiangular_samples += o.equiangular_samples;
     }
 }
 

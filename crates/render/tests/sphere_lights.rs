@@ -6,6 +6,8 @@
 //!   substitution `t = delta + h tan(theta)` makes smooth (`dt / d^2 =
 //!   dtheta / h`) and Simpson's rule integrates here;
 //! - a spot light is the same integral times its cone's falloff;
+//!   (each with equi-angular sampling beside the free flight, the default,
+//!   and the point light with free flights alone as well);
 //! - a small ball lights as the point of its intensity `L pi r^2`;
 //! - a ball seen by the camera shows its radiance times the transmittance
 //!   to it, grey and chromatic (the flight split at the ball);
@@ -16,8 +18,8 @@
 mod common;
 
 use cirrus_render::{
-    render, Bounds3, Camera, ConstantBox, Environment, IntegratorKind, Light, LightSampling,
-    Lights, Medium, Rendered, Scene, SphereLight, Spot, Volumes,
+    render, Bounds3, Camera, ConstantBox, DistanceSampling, Environment, IntegratorKind, Light,
+    LightSampling, Lights, Medium, Rendered, Scene, SphereLight, Spot, Volumes,
 };
 use glam::Vec3;
 
@@ -44,8 +46,19 @@ fn camera() -> Camera {
 }
 
 fn render_fog(lights: Lights, max_depth: Option<u32>, spp: u32, seed: u64) -> Rendered {
+    render_fog_with(lights, max_depth, spp, seed, DistanceSampling::default())
+}
+
+fn render_fog_with(
+    lights: Lights,
+    max_depth: Option<u32>,
+    spp: u32,
+    seed: u64,
+    distance_sampling: DistanceSampling,
+) -> Rendered {
     let mut s = common::settings(IntegratorKind::Path, spp, seed);
     s.max_depth = max_depth;
+    s.distance_sampling = distance_sampling;
     let scene = Scene {
         media: Volumes::from(fog()),
         camera: camera(),
@@ -154,10 +167,21 @@ const INTENSITY: Vec3 = Vec3::new(40.0, 25.0, 12.0);
 #[test]
 fn a_point_light_single_scatters_the_airlight_integral() {
     let light = SphereLight::new(Vec3::ZERO, 0.0, INTENSITY);
-    let out = render_fog(Lights::new([light.into()]), Some(1), 64, 3);
-    assert!(out.stats.counters.nee_rays_sphere > 0);
-    let expected = airlight_image(INTENSITY, Vec3::ZERO, &|_| 1.0);
-    assert_matches("point light", &out, &every(expected));
+    let expected = every(airlight_image(INTENSITY, Vec3::ZERO, &|_| 1.0));
+    for sampling in [DistanceSampling::Equiangular, DistanceSampling::FreeFlight] {
+        let out = render_fog_with(Lights::new([light.into()]), Some(1), 64, 3, sampling);
+        let c = &out.stats.counters;
+        assert!(c.nee_rays_sphere > 0);
+        assert_eq!(
+            c.equiangular_samples > 0,
+            sampling == DistanceSampling::Equiangular
+        );
+        assert_matches(
+            &format!("point light, {}", sampling.name()),
+            &out,
+            &expected,
+        );
+    }
 }
 
 #[test]
@@ -193,10 +217,16 @@ fn a_spot_light_single_scatters_the_airlight_integral_in_its_cone() {
 #[test]
 fn a_small_ball_lights_as_the_point_of_its_intensity() {
     // r / d <= 0.05 / 1.4 everywhere a camera ray passes: the ball's cone
-    // against the point's delta differs by O((r / d)^2), about 0.1%.
-    let ball = SphereLight::new(Vec3::ZERO, 0.05, INTENSITY);
+    // against the point's delta differs by O((r / d)^2), under 0.1%. Its
+    // light travels less fog than the point's: to the near surface, on
+    // average 2r/3 short of the centre over the cone (1 - sqrt(1 - x) over
+    // x uniform in [0, 1], the cone's solid angle to first order), which
+    // the expected image takes as exp(2 sigma_t r / 3), 1.3% here.
+    let r = 0.05;
+    let ball = SphereLight::new(Vec3::ZERO, r, INTENSITY);
     let out = render_fog(Lights::new([ball.into()]), Some(1), 64, 7);
-    let expected = airlight_image(INTENSITY, Vec3::ZERO, &|_| 1.0);
+    let nearer = (2.0 * SIGMA_T as f64 * r as f64 / 3.0).exp();
+    let expected = airlight_image(INTENSITY, Vec3::ZERO, &|_| nearer);
     assert_matches("small ball", &out, &every(expected));
 }
 
@@ -308,5 +338,33 @@ fn a_large_ball_renders_alike_with_one_light_picked_and_every_light() {
     for channel in 0..3 {
         let d = common::differences(&all.image, &one.image, channel);
         common::assert_pooled_agreement(&format!("large ball, channel {channel}"), &d);
+    }
+}
+
+/// A point light inside the cloud, and a spot light above it shining
+/// into it: equi-angular sampling and free flights alone render the same
+/// multiple scattering, grey and chromatic.
+#[test]
+fn equiangular_sampling_agrees_with_free_flights_in_a_heterogeneous_cloud() {
+    let point = SphereLight::new(Vec3::new(0.5, 0.45, 0.5), 0.0, Vec3::new(0.3, 0.25, 0.2));
+    let spot = SphereLight::new(Vec3::new(0.45, 1.2, 0.4), 0.0, Vec3::splat(1.0)).with_spot(
+        Spot::new(Vec3::new(0.1, -1.0, 0.0), 20f32.to_radians(), 0.3),
+    );
+    for (label, tint) in [("grey", Vec3::ONE), ("chromatic", Vec3::new(1.0, 0.7, 0.4))] {
+        let medium =
+            || common::medium(common::cloud_field(4), 12.0, 0.9, 0.5).with_extinction_tint(tint);
+        let lights = || Lights::new([point.into(), spot.into()]);
+        let mut s = common::settings(IntegratorKind::Path, 64, 31);
+        s.max_depth = Some(6);
+        let ea = render(&common::scene(medium(), 20, lights()), &s);
+        s.distance_sampling = DistanceSampling::FreeFlight;
+        s.seed = 32;
+        let ff = render(&common::scene(medium(), 20, lights()), &s);
+        assert!(ea.stats.counters.equiangular_samples > 0);
+        assert_eq!(ff.stats.counters.equiangular_samples, 0);
+        for channel in 0..3 {
+            let d = common::differences(&ea.image, &ff.image, channel);
+            common::assert_pooled_agreement(&format!("{label}, channel {channel}"), &d);
+        }
     }
 }

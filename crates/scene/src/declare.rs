@@ -22,8 +22,8 @@ use std::path::PathBuf;
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward, TransmittanceEstimator,
-    VelocityUnit,
+    DistanceSampling, IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward,
+    TransmittanceEstimator, VelocityUnit,
 };
 
 use crate::values::Colour;
@@ -73,6 +73,7 @@ macro_rules! shown_by_name {
 shown_by_name!(
     LightSampling,
     Sunward,
+    DistanceSampling,
     IntegratorKind,
     TransmittanceEstimator,
     MajorantMode,

@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{
-    IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward, TransmittanceEstimator,
-    VelocityUnit,
+    DistanceSampling, IntegratorKind, LightSampling, MajorantMode, SamplerKind, Sunward,
+    TransmittanceEstimator, VelocityUnit,
 };
 
 use crate::declare::declare_settings;
@@ -113,6 +113,11 @@ declare_settings! {
     /// function's mean cosine is at least 0.6, where it was measured to
     /// pay.
     sunward: Sunward, flag(long, value_enum), default(Sunward::default()), example(Sunward::Off);
+    /// Where light scatters along a ray: free flights and equi-angular
+    /// sampling toward sphere, point and spot lights weighed by MIS (what
+    /// makes a beam in fog converge), or free flights alone.
+    distance_sampling: DistanceSampling, flag(long, value_enum),
+        default(DistanceSampling::default()), example(DistanceSampling::FreeFlight);
     /// Real scattering events per path (0: only the sky through the volume,
     /// 1: single scattering).
     max_depth: u32, flag(long), unset("unlimited, ended by Russian roulette"), example(1);

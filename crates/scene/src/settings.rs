@@ -50,6 +50,7 @@ impl SceneSettings {
             majorant: r.majorant(),
             light_sampling: r.light_sampling(),
             sunward: r.sunward(),
+            distance_sampling: r.distance_sampling(),
             budget,
             seed: r.seed(),
             sampler: r.sampler(),

@@ -1,16 +1,18 @@
 //! Volumetric path tracing: the path loop (`path.rs`), the free flight
-//! past sphere lights (`path_flight.rs`), next-event estimation
-//! (`path_light.rs`) and sunward scattering (`path_sunward.rs`).
+//! past sphere lights (`path_flight.rs`), equi-angular sampling toward
+//! them (`path_equiangular.rs`), next-event estimation (`path_light.rs`)
+//! and sunward scattering (`path_sunward.rs`).
 
 use glam::Vec3;
 
 use super::light_choice::{LightChoice, LightSampler, LightSampling, PerLight};
 use super::light_grid::LightGrid;
+use super::path_equiangular::DistanceSampling;
 use super::path_state::{Arrival, At, Escape, Path, Vertex};
 use super::sunward_mode::Sunward;
 use super::{escaped_radiance, AovSample, CameraSampler, Sample};
 use crate::compositing::GroupRadiance;
-use crate::light::{Light, Lights, Sun};
+use crate::light::{Light, Lights, SphereLight, Sun};
 use crate::medium::{Interaction, Media};
 use crate::phase::Phase;
 use crate::ray::Ray;
@@ -89,6 +91,11 @@ pub struct PathTracer<'a, M> {
     chromatic: bool,
     /// Whether any light is a ball that rays can meet (`path_flight.rs`).
     pub(super) has_balls: bool,
+    /// The sphere, point and spot lights, with their indices.
+    pub(super) spheres: Vec<(usize, SphereLight)>,
+    /// Whether segments take an equi-angular sample toward them
+    /// (`path_equiangular.rs`).
+    pub(super) equiangular: bool,
     /// Tag contributions with their light groups (off: `Sample::groups`
     /// stays zero and costs nothing).
     pub(super) light_groups: bool,
@@ -113,6 +120,15 @@ impl<'a, M: Media> PathTracer<'a, M> {
     ) -> Self {
         let lights = lights.pruned();
         let has_balls = lights.balls().next().is_some();
+        let spheres: Vec<(usize, SphereLight)> = lights
+            .iter()
+            .enumerate()
+            .filter_map(|(i, l)| match l {
+                Light::Sphere(s) => Some((i, *s)),
+                _ => None,
+            })
+            .collect();
+        let equiangular = !spheres.is_empty();
         // The first of the brightest, where several are alike.
         let sunward_light = lights
             .distant()
@@ -122,6 +138,8 @@ impl<'a, M: Media> PathTracer<'a, M> {
         Self {
             medium,
             has_balls,
+            spheres,
+            equiangular,
             sunward_light,
             sampler: LightSampler::new(&lights, LightSampling::default()),
             lights,
@@ -190,6 +208,15 @@ impl<'a, M: Media> PathTracer<'a, M> {
         }
     }
 
+    /// Samples distances along segments as `sampling` says (equi-angular
+    /// sampling only where there are sphere lights).
+    pub fn with_distance_sampling(self, sampling: DistanceSampling) -> Self {
+        Self {
+            equiangular: sampling == DistanceSampling::Equiangular && !self.spheres.is_empty(),
+            ..self
+        }
+    }
+
     /// Gathers the next vertex's sunlight by sunward scattering as well
     /// where `sunward` says.
     pub fn with_sunward(self, sunward: Sunward) -> Self {
@@ -251,6 +278,9 @@ impl<M: Media> PathTracer<'_, M> {
             // This free flight and the events at its collision are path
             // vertex `path.depth` of the draw allocation.
             let vertex = path.depth;
+            if self.equiangular && self.equiangular_runs(&path) {
+                self.equiangular::<S>(&mut path, draws, c);
+            }
             let flight = self.fly::<S>(&mut path, vertex, draws, c);
             if path.depth == 0 {
                 path.out.alpha = match flight {

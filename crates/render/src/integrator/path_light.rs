@@ -9,7 +9,7 @@ use super::light_choice::LightChoice;
 use super::path::PathTracer;
 use super::path_state::Vertex;
 use super::LightParts;
-use crate::light::{Environment, Light, LightSample};
+use crate::light::{Environment, Light, LightSample, SphereLight};
 use crate::medium::Media;
 use crate::sampling::{power_heuristic, Draw, SampleStream};
 use crate::spectrum::Spectrum;
@@ -66,9 +66,16 @@ impl<M: Media> PathTracer<'_, M> {
         draws: &mut SampleStream,
         c: &mut Counters,
     ) -> Vec3 {
+        let light = self.lights.get(i);
+        if let Light::Sphere(sphere) = light {
+            // Shared with the equi-angular sample of the segment that
+            // reached the vertex (`path_equiangular.rs`).
+            let w = self.collision_weight(v, sphere);
+            return w * self.sphere_sample::<S>(v, sphere, pick, k, draws, c);
+        }
         let (u1, u2) = draws.get_2d(Draw::LightDirection(k), v.index);
         let shadow = Draw::LightShadow(k);
-        match self.lights.get(i) {
+        match light {
             Light::Distant(sun) => {
                 let s = sun.sample(u1, u2);
                 c.nee_rays_distant += 1;
@@ -88,17 +95,30 @@ impl<M: Media> PathTracer<'_, M> {
                 c.nee_rays_dome += u64::from(s.pdf.is_some_and(|p| p > 0.0));
                 self.light_term::<S>(v, s, pick, shadow, draws, c)
             }
-            Light::Sphere(light) => {
-                let s = light.sample(v.p, u1, u2);
-                // Outside a spot's cone, or inside the ball: no light, no
-                // shadow ray.
-                if s.radiance == Vec3::ZERO {
-                    return Vec3::ZERO;
-                }
-                c.nee_rays_sphere += 1;
-                self.light_term::<S>(v, s, pick, shadow, draws, c)
-            }
+            Light::Sphere(_) => unreachable!("sampled above"),
         }
+    }
+
+    /// The `k`-th light sample at `v` of sphere light `light`, which the
+    /// vertex samples with probability `pick`.
+    pub(super) fn sphere_sample<S: Spectrum>(
+        &self,
+        v: &Vertex,
+        light: &SphereLight,
+        pick: f32,
+        k: u32,
+        draws: &mut SampleStream,
+        c: &mut Counters,
+    ) -> Vec3 {
+        let (u1, u2) = draws.get_2d(Draw::LightDirection(k), v.index);
+        let s = light.sample(v.p, u1, u2);
+        // Outside a spot's cone, or inside the ball: no light, no shadow
+        // ray.
+        if s.radiance == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        c.nee_rays_sphere += 1;
+        self.light_term::<S>(v, s, pick, Draw::LightShadow(k), draws, c)
     }
 
     /// The sky's direction at `v`: drawn from the sky itself, except for a
