@@ -6,8 +6,8 @@
 //!   substitution `t = delta + h tan(theta)` makes smooth (`dt / d^2 =
 //!   dtheta / h`) and Simpson's rule integrates here;
 //! - a spot light is the same integral times its cone's falloff;
-//!   (each with equi-angular sampling beside the free flight, the default,
-//!   and the point light with free flights alone as well);
+//!   (each with equi-angular sampling beside the free flight, and the
+//!   point light with free flights alone as well);
 //! - a small ball lights as the point of its intensity `L pi r^2`;
 //! - a ball seen by the camera shows its radiance times the transmittance
 //!   to it, grey and chromatic (the flight split at the ball);
@@ -46,7 +46,7 @@ fn camera() -> Camera {
 }
 
 fn render_fog(lights: Lights, max_depth: Option<u32>, spp: u32, seed: u64) -> Rendered {
-    render_fog_with(lights, max_depth, spp, seed, DistanceSampling::default())
+    render_fog_with(lights, max_depth, spp, seed, DistanceSampling::Equiangular)
 }
 
 fn render_fog_with(
@@ -356,6 +356,7 @@ fn equiangular_sampling_agrees_with_free_flights_in_a_heterogeneous_cloud() {
         let lights = || Lights::new([point.into(), spot.into()]);
         let mut s = common::settings(IntegratorKind::Path, 64, 31);
         s.max_depth = Some(6);
+        s.distance_sampling = DistanceSampling::Equiangular;
         let ea = render(&common::scene(medium(), 20, lights()), &s);
         s.distance_sampling = DistanceSampling::FreeFlight;
         s.seed = 32;

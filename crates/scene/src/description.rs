@@ -115,7 +115,9 @@ declare_settings! {
     sunward: Sunward, flag(long, value_enum), default(Sunward::default()), example(Sunward::Off);
     /// Where light scatters along a ray: free flights and equi-angular
     /// sampling toward sphere, point and spot lights weighed by MIS (what
-    /// makes a beam in fog converge), or free flights alone.
+    /// makes a beam in fog converge), or free flights alone; `auto`
+    /// samples equi-angularly where the media are thin (under 3 mean free
+    /// paths across at their densest).
     distance_sampling: DistanceSampling, flag(long, value_enum),
         default(DistanceSampling::default()), example(DistanceSampling::FreeFlight);
     /// Real scattering events per path (0: only the sky through the volume,

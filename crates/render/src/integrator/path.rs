@@ -128,7 +128,8 @@ impl<'a, M: Media> PathTracer<'a, M> {
                 _ => None,
             })
             .collect();
-        let equiangular = !spheres.is_empty();
+        let equiangular =
+            !spheres.is_empty() && DistanceSampling::default().samples_equiangular(medium);
         // The first of the brightest, where several are alike.
         let sunward_light = lights
             .distant()
@@ -212,7 +213,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     /// sampling only where there are sphere lights).
     pub fn with_distance_sampling(self, sampling: DistanceSampling) -> Self {
         Self {
-            equiangular: sampling == DistanceSampling::Equiangular && !self.spheres.is_empty(),
+            equiangular: !self.spheres.is_empty() && sampling.samples_equiangular(self.medium),
             ..self
         }
     }
