@@ -396,7 +396,7 @@ impl SceneDescription {
         if let Some(map) = self.environment.as_mut().and_then(|e| e.env_map.as_mut()) {
             *map = dir.join(&*map);
         }
-        crate::lights::rebase(&mut self.lights, dir);
+        LightSpec::rebase_all(&mut self.lights, dir);
         if let Some(spec) = self.render.holdout_depth.as_mut() {
             let (file, channel) = crate::parse::split_depth_spec(spec);
             let file = dir.join(file).display().to_string();
@@ -464,7 +464,7 @@ impl SceneDescription {
             v.check()
                 .map_err(|e| format!("volume {} ({}): {e}", i + 1, v.file.display()))?;
         }
-        crate::lights::check_all(&self.lights)?;
+        LightSpec::check_all(&self.lights)?;
         self.camera.check().map_err(|e| format!("[camera] {e}"))
     }
 }

@@ -301,18 +301,21 @@ pub fn lights(desc: &SceneDescription) -> Result<Lights> {
     Ok(Lights::grouped(list, index(DEFAULT_LIGHT_GROUPS[2])).pruned())
 }
 
-/// Checks every `[[light]]` of a description, naming the light.
-pub(crate) fn check_all(lights: &[LightSpec]) -> std::result::Result<(), String> {
-    for (i, spec) in lights.iter().enumerate() {
-        spec.check()
-            .map_err(|e| format!("{}: {e}", spec.label(i)))?;
+impl LightSpec {
+    /// Checks every `[[light]]` of a description, naming the light, and
+    /// that their light groups fit the film.
+    pub fn check_all(lights: &[LightSpec]) -> std::result::Result<(), String> {
+        for (i, spec) in lights.iter().enumerate() {
+            spec.check()
+                .map_err(|e| format!("{}: {e}", spec.label(i)))?;
+        }
+        group_names(lights).map(|_| ())
     }
-    group_names(lights).map(|_| ())
-}
 
-/// Each dome map's path relative to `dir`, as a scene file's are.
-pub(crate) fn rebase(lights: &mut [LightSpec], dir: &Path) {
-    for map in lights.iter_mut().filter_map(|l| l.map.as_mut()) {
-        *map = dir.join(&*map);
+    /// Each dome map's path relative to `dir`, as a scene file's are.
+    pub fn rebase_all(lights: &mut [LightSpec], dir: &Path) {
+        for map in lights.iter_mut().filter_map(|l| l.map.as_mut()) {
+            *map = dir.join(&*map);
+        }
     }
 }

@@ -48,6 +48,7 @@
 
 use glam::Vec3;
 
+use super::light_sampling::LightSampling;
 use super::many_lights::ManyLights;
 use super::per_light::{
     into_shares, lane_shares, lanes_of, raise_to_floors, Lanes, Shares, MIN_PROBABILITY,
@@ -56,49 +57,6 @@ pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
 use crate::light::{Light, Lights, SphereLight};
 use crate::phase::Phase;
 use crate::sampling::UNIFORM_SPHERE_PDF;
-
-settings_enum! {
-    /// How many lights next-event estimation samples at each vertex.
-    pub enum LightSampling {
-        /// `one` under a constant sky (with or without a sun), `all` otherwise.
-        #[default]
-        Auto = "auto",
-        /// Every light, one sample each.
-        All = "all",
-        /// One light (or, deep in the media, most often none), picked in
-        /// proportion to its in-scattered radiance at the vertex seen through
-        /// the media (past 8 lights, by what each sends toward the vertex:
-        /// `many_lights.rs`).
-        One = "one",
-        /// One light picked uniformly at random (the baseline the weighed
-        /// pick is measured against).
-        Uniform = "uniform",
-    }
-}
-
-impl LightSampling {
-    /// Whether a vertex picks one light under `lights` (pruned of the dark
-    /// ones) through a shadow grid: `one`, resolved, with a light to pick
-    /// and no more than [`MAX_PICKED_LIGHTS`].
-    pub fn picks_one(self, lights: &Lights) -> bool {
-        self.resolve(lights) == Self::One && !lights.is_empty() && lights.len() <= MAX_PICKED_LIGHTS
-    }
-
-    /// What `self` comes to under `lights`: `All`, `One` or `Uniform`
-    /// (`auto` is `One` past [`MAX_PICKED_LIGHTS`] lights).
-    pub fn resolve(self, lights: &Lights) -> LightSampling {
-        match self {
-            Self::Auto if lights.len() > MAX_PICKED_LIGHTS => Self::One,
-            Self::Auto
-                if lights.domes().next().is_some() && lights.domes().all(|e| e.map.is_none()) =>
-            {
-                Self::One
-            }
-            Self::Auto => Self::All,
-            other => other,
-        }
-    }
-}
 
 /// A vertex whose lights, seen through the media, bring at least this
 /// fraction of their unoccluded in-scattered radiance always traces a

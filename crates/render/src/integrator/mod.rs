@@ -7,8 +7,10 @@
 //!   in a sparse grid (`light_grid`) and camera rays marched through it.
 //! - `march`: the jittered fixed-step quadrature both marchers share.
 
+mod distance_sampling;
 mod light_choice;
 mod light_grid;
+mod light_sampling;
 mod many_lights;
 mod march;
 mod path;
@@ -22,10 +24,10 @@ mod raymarch;
 mod raymarch2pass;
 mod sunward_mode;
 
-pub use light_choice::LightSampling;
+pub use distance_sampling::DistanceSampling;
 pub use light_grid::{LightGrid, LightGridSettings};
+pub use light_sampling::LightSampling;
 pub use path::PathTracer;
-pub use path_equiangular::DistanceSampling;
 pub use path_sunward::KEEP_THRESHOLD;
 pub use raymarch::RayMarcher;
 pub use raymarch2pass::TwoPassMarcher;

@@ -5,9 +5,10 @@
 
 use glam::Vec3;
 
-use super::light_choice::{LightChoice, LightSampler, LightSampling, PerLight};
+use super::distance_sampling::DistanceSampling;
+use super::light_choice::{LightChoice, LightSampler, PerLight};
 use super::light_grid::LightGrid;
-use super::path_equiangular::DistanceSampling;
+use super::light_sampling::LightSampling;
 use super::path_state::{Arrival, At, Escape, Path, Vertex};
 use super::sunward_mode::Sunward;
 use super::{escaped_radiance, AovSample, CameraSampler, Sample};
