@@ -14,16 +14,36 @@ Needs numpy and OpenEXR (`pip install numpy OpenEXR`).
 from __future__ import annotations
 
 import argparse
-import json
 import math
-import subprocess
 import tempfile
 from pathlib import Path
 
 import numpy as np
-import OpenEXR
+
+from cirrus_runs import render_rgb
 
 REPO = Path(__file__).resolve().parents[1]
+
+
+def lamp_in_cloud(density_scale: float) -> str:
+    """A point light inside the corpus cloud at `density_scale`."""
+    return f"""
+[camera]
+res = "128x96"
+from = [150, 83, -250]
+to = [150, 83, 100]
+fov = 40
+[[light]]
+type = "point"
+position = [150, 90, 100]
+intensity = 30000
+[[volume]]
+file = "{REPO / 'data' / 'cloud.vdb'}"
+density_scale = {density_scale}
+albedo = 0.9
+g = 0.5
+"""
+
 
 SCENES = {
     # A spot light high in a box of thin fog, its beam crossing the view.
@@ -46,52 +66,14 @@ density_scale = 0.004
 albedo = 0.9
 g = 0.3
 """,
-    # A lamp inside the corpus cloud (its default density).
-    "point in cloud": f"""
-[camera]
-res = "128x96"
-from = [150, 83, -250]
-to = [150, 83, 100]
-fov = 40
-[[light]]
-type = "point"
-position = [150, 90, 100]
-intensity = 30000
-[[volume]]
-file = "{REPO / 'data' / 'cloud.vdb'}"
-density_scale = 0.2
-albedo = 0.9
-g = 0.5
-""",
-
-    # The same, its density a tenth.
-        "point in thin cloud": f"""
-[camera]
-res = "128x96"
-from = [150, 83, -250]
-to = [150, 83, 100]
-fov = 40
-[[light]]
-type = "point"
-position = [150, 90, 100]
-intensity = 30000
-[[volume]]
-file = "{REPO / 'data' / 'cloud.vdb'}"
-density_scale = 0.02
-albedo = 0.9
-g = 0.5
-""",
+    # A lamp inside the corpus cloud, thin and thick.
+    "point in thin cloud": lamp_in_cloud(0.02),
+    "point in cloud": lamp_in_cloud(0.2),
 }
 
 
-def render(cirrus: str, text: str, spp: int, seed: int, sampling: str, d: Path) -> tuple[np.ndarray, float]:
-    toml = d / "scene.toml"
-    toml.write_text(text + f"\n[render]\nspp = {spp}\nseed = {seed}\ndistance_sampling = \"{sampling}\"\n")
-    out, stats = d / "out.exr", d / "stats.json"
-    subprocess.run([cirrus, "render", str(toml), "-o", str(out), "--stats", str(stats)],
-                   check=True, capture_output=True)
-    rgba = OpenEXR.File(str(out)).parts[0].channels["RGBA"].pixels
-    return rgba[..., :3].astype(np.float64), json.loads(stats.read_text())["wall_seconds"]
+def with_render(text: str, spp: int, seed: int, sampling: str) -> str:
+    return text + f"\n[render]\nspp = {spp}\nseed = {seed}\ndistance_sampling = \"{sampling}\"\n"
 
 
 def main() -> None:
@@ -102,12 +84,12 @@ def main() -> None:
     a = ap.parse_args()
     d = Path(tempfile.mkdtemp(prefix="cirrus-ea-"))
     for name, text in SCENES.items():
-        ref, _ = render(a.cirrus, text, a.ref_spp, 1000, "equiangular", d)
+        ref, _ = render_rgb(a.cirrus, with_render(text, a.ref_spp, 1000, "equiangular"), d, "ref")
         rows = {}
         for sampling in ("free-flight", "equiangular", "auto"):
             errs, times = [], []
             for seed in (1, 2, 3):
-                img, t = render(a.cirrus, text, a.spp, seed, sampling, d)
+                img, t = render_rgb(a.cirrus, with_render(text, a.spp, seed, sampling), d, "run")
                 errs.append(np.mean((img - ref) ** 2))
                 times.append(t)
             rows[sampling] = (float(np.mean(errs)), float(np.mean(times)))

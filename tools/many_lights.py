@@ -18,12 +18,12 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import subprocess
 import tempfile
 from pathlib import Path
 
 import numpy as np
-import OpenEXR
+
+from cirrus_runs import render_rgb
 
 REPO = Path(__file__).resolve().parents[1]
 CLOUD = REPO / "data" / "cloud.vdb"
@@ -74,16 +74,6 @@ g = 0.3
 """
 
 
-def render(cirrus: str, text: str, d: Path, name: str) -> tuple[np.ndarray, float]:
-    toml = d / f"{name}.toml"
-    toml.write_text(text)
-    out, stats = d / f"{name}.exr", d / f"{name}.json"
-    subprocess.run([cirrus, "render", str(toml), "-o", str(out), "--stats", str(stats)],
-                   check=True, capture_output=True)
-    rgba = OpenEXR.File(str(out)).parts[0].channels["RGBA"].pixels
-    return rgba[..., :3].astype(np.float64), json.loads(stats.read_text())["wall_seconds"]
-
-
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("cirrus", nargs="?", default=str(REPO / "target" / "release" / "cirrus"))
@@ -93,12 +83,12 @@ def main() -> None:
     a = ap.parse_args()
     d = Path(tempfile.mkdtemp(prefix="cirrus-many-"))
     for n in (int(x) for x in a.lights.split(",")):
-        ref, _ = render(a.cirrus, scene(n, a.ref_spp, "auto", 1000), d, f"ref{n}")
+        ref, _ = render_rgb(a.cirrus, scene(n, a.ref_spp, "auto", 1000), d, f"ref{n}")
         rows = {}
         for sampling in ("uniform", "auto", "all"):
             errs, times = [], []
             for seed in (1, 2, 3):
-                img, t = render(a.cirrus, scene(n, a.spp, sampling, seed), d, f"{sampling}{n}")
+                img, t = render_rgb(a.cirrus, scene(n, a.spp, sampling, seed), d, f"{sampling}{n}")
                 errs.append(np.mean((img - ref) ** 2))
                 times.append(t)
             rows[sampling] = (float(np.mean(errs)), float(np.mean(times)))

@@ -77,6 +77,18 @@ def author_shot(d: Path, instances=(("A", 0.0), ("B", 300.0)), mesh=False) -> Pa
     return d / "shot.usda"
 
 
+def camera_twin(cam: Gf.Matrix4d) -> dict:
+    """The `[camera]` of `us.camera` with the world matrix `cam`."""
+    return {
+        "res": f"{RES}x{RES}",
+        "matrix": us.rows(cam),
+        "focal_length": 35.0,
+        "horizontal_aperture": 24.0,
+        "vertical_aperture": 24.0,
+        "clipping": [1.0, 100000.0],
+    }
+
+
 def shot_twin(d: Path, camera: dict | None = None, moved: float = 0.0) -> dict:
     """The TOML scene of `author_shot`, with numbers from usd-core."""
     stage = Usd.Stage.Open(str(d / "shot.usda"))
@@ -90,15 +102,7 @@ def shot_twin(d: Path, camera: dict | None = None, moved: float = 0.0) -> dict:
         "transform": {"translate": [10 + 0.5 * (x - 100) + moved, 0.0, 15.0], "scale": 0.5},
     }
     return {
-        "camera": camera
-        or {
-            "res": f"{RES}x{RES}",
-            "matrix": us.rows(cam),
-            "focal_length": 35.0,
-            "horizontal_aperture": 24.0,
-            "vertical_aperture": 24.0,
-            "clipping": [1.0, 100000.0],
-        },
+        "camera": camera or camera_twin(cam),
         "sun": {
             "direction": [-sun[2][0], -sun[2][1], -sun[2][2]],
             "irradiance": [float(F32(c)) * 3.0 for c in (1.0, 0.95, 0.9)],
@@ -334,14 +338,7 @@ def lights_twin(d: Path) -> dict:
     axis = lamp.TransformDir(Gf.Vec3d(0, 0, -1))
     scale = sum(bulb.TransformDir(Gf.Vec3d(*e)).GetLength() for e in ((1, 0, 0), (0, 1, 0), (0, 0, 1))) / 3
     return {
-        "camera": {
-            "res": f"{RES}x{RES}",
-            "matrix": us.rows(cam),
-            "focal_length": 35.0,
-            "horizontal_aperture": 24.0,
-            "vertical_aperture": 24.0,
-            "clipping": [1.0, 100000.0],
-        },
+        "camera": camera_twin(cam),
         "sun": {"direction": [-sun[2][0], -sun[2][1], -sun[2][2]], "irradiance": [3.0] * 3, "angle": 0.53},
         "environment": {"radiance": [0.0, 0.0, 0.0]},
         "light": [
