@@ -94,7 +94,7 @@ f, t = j("pay_full"), j("pay_tenth")
 print(f"cloud filling the frame:     {f['wall_seconds']:.2f} s, {f['density_lookups']} lookups")
 print(f"cloud at a tenth of the frame: {t['wall_seconds']:.2f} s, {t['density_lookups']} lookups ({t['wall_seconds']/f['wall_seconds']:.3f} x the time)")
 s = j("pay_sun")
-keys = ["emission_lookups", "dome_samples", "nee_rays_dome", "nee_rays_distant", "nee_rays_sphere", "equiangular_samples", "grids_loaded"]
+keys = ["emission_lookups", "dome_samples", "nee_rays_dome", "nee_rays_distant", "nee_rays_sphere", "nee_rays_area", "equiangular_samples", "grids_loaded"]
 print("sun only, no emission grid: " + ", ".join(f"{k} {s.get(k)}" for k in keys))
 PY
 )"

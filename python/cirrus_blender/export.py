@@ -24,7 +24,9 @@ What is mapped:
   direction; its radius makes it a ball of that intensity) and spot lamps
   (the same, in a cone of half the spot size, its edge blended over
   `spot_blend` of the cone's `1 - cos`, as Cycles' smoothstep does), each
-  named by its object (its light-group layer); Cycles' soft falloff (on by
+  named by its object (its light-group layer), and area lamps (square,
+  rectangle, disk, ellipse; Cycles' radiance `P c / (pi A)`, the size
+  scaled by the object, emitting along -Z); Cycles' soft falloff (on by
   default) changes a lamp's light only near its surface, where cirrus's
   ball is uniform; the world's Background
   colour or an equirectangular Environment Texture, and the scene camera
@@ -75,9 +77,11 @@ class Export:
                 suns.append((obj, inst.matrix_world.copy()))
             elif obj.type == "LIGHT" and obj.data.type in ("POINT", "SPOT"):
                 self.lamp(obj, inst.matrix_world.copy())
+            elif obj.type == "LIGHT" and obj.data.type == "AREA":
+                self.area_lamp(obj, inst.matrix_world.copy())
             elif obj.type == "LIGHT":
                 self.warn(f"{obj.name}: {obj.data.type.lower()} lamps are not rendered "
-                          "(sun, point and spot lamps are)")
+                          "(sun, point, spot and area lamps are)")
             elif obj.type == "CAMERA":
                 continue
             elif obj.type in ("EMPTY",):
@@ -275,6 +279,36 @@ class Export:
                 "cone_softness": float(light.spot_blend),
             })
         self.desc.setdefault("light", []).append(entry)
+
+    def area_lamp(self, obj, m) -> None:
+        """An area lamp as a `rect` or `disk` `[[light]]`: Cycles' radiance
+        `P c / (pi A)` (normalised; `P c / pi` if not), its size scaled by
+        the object, emitting along its -Z."""
+        light = obj.data
+        world = Y_UP @ m
+        axes = world.to_3x3()
+        x, y, z = axes.col[0], axes.col[1], axes.col[2]
+        two_sizes = light.shape in ("RECTANGLE", "ELLIPSE")
+        width = float(light.size) * x.length
+        height = float(light.size_y if two_sizes else light.size) * y.length
+        rect = light.shape in ("SQUARE", "RECTANGLE")
+        area = width * height if rect else 0.25 * math.pi * width * height
+        if getattr(light, "normalize", True):
+            scale = float(light.energy) / (math.pi * area)
+        else:
+            scale = float(light.energy) / math.pi
+        if getattr(light, "spread", math.pi) < math.pi - 1e-6:
+            self.warn(f"{obj.name}: the area lamp's spread is not applied (it emits over the hemisphere)")
+        self.desc.setdefault("light", []).append({
+            "type": "rect" if rect else "disk",
+            "name": obj.name,
+            "position": list(world.to_translation()),
+            "direction": list((-z).normalized()),
+            "up": list(y.normalized()),
+            "width": width,
+            "height": height,
+            "color": [float(c) * scale for c in light.color],
+        })
 
     def world(self) -> None:
         world = self.scene.world

@@ -287,8 +287,9 @@ def down_matrix(at) -> Gf.Matrix4d:
 
 def author_lights(d: Path) -> Path:
     """The cloud lit by every light kind the reader takes: a sun, a moon (a
-    second distant light), a sphere light moved and scaled, and a point
-    spot shaped by UsdLux's ShapingAPI, turned to point down."""
+    second distant light), a sphere light moved and scaled, a point spot
+    shaped by UsdLux's ShapingAPI turned to point down, and a rect light
+    facing down."""
     from pxr import UsdLux
 
     d.mkdir(parents=True, exist_ok=True)
@@ -320,6 +321,12 @@ def author_lights(d: Path) -> Path:
     shaping.CreateShapingConeAngleAttr(25.0)
     shaping.CreateShapingConeSoftnessAttr(0.3)
     lamp.AddTransformOp().Set(down_matrix((110.0, 200.0, 60.0)))
+    panel = UsdLux.RectLight.Define(stage, "/Lights/Panel")
+    panel.CreateWidthAttr(40.0)
+    panel.CreateHeightAttr(25.0)
+    panel.CreateIntensityAttr(2.5)
+    panel.CreateNormalizeAttr(True)
+    panel.AddTransformOp().Set(down_matrix((170.0, 190.0, 90.0)))
     us.camera(stage)
     us.render_settings(stage, res=(RES, RES))
     stage.GetRootLayer().Save()
@@ -335,6 +342,7 @@ def lights_twin(d: Path) -> dict:
     moon = world("/Lights/Moon").TransformDir(Gf.Vec3d(0, 0, -1))
     bulb = world("/Lights/Bulb")
     lamp = world("/Lights/Lamp")
+    panel = world("/Lights/Panel")
     axis = lamp.TransformDir(Gf.Vec3d(0, 0, -1))
     scale = sum(bulb.TransformDir(Gf.Vec3d(*e)).GetLength() for e in ((1, 0, 0), (0, 1, 0), (0, 0, 1))) / 3
     return {
@@ -361,6 +369,17 @@ def lights_twin(d: Path) -> dict:
                 "direction": list(axis),
                 "cone_angle": 25.0,
                 "cone_softness": float(F32(0.3)),
+            },
+            {
+                "type": "rect",
+                "name": "Panel",
+                "position": list(panel.Transform(Gf.Vec3d(0, 0, 0))),
+                "direction": list(panel.TransformDir(Gf.Vec3d(0, 0, -1))),
+                "up": list(panel.TransformDir(Gf.Vec3d(0, 1, 0))),
+                "width": 40.0,
+                "height": 25.0,
+                "color": [2.5] * 3,
+                "normalize": True,
             },
         ],
         "volume": [

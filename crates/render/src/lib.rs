@@ -88,7 +88,9 @@ pub use integrator::{
     AovSample, CameraSampler, DistanceSampling, IntegratorKind, LightGrid, LightGridSettings,
     LightSampling, PathTracer, RayMarcher, Sample, Sunward, TwoPassMarcher,
 };
-pub use light::{Environment, Light, LightKind, Lights, SphereLight, Spot, Sun};
+pub use light::{
+    AreaLight, AreaShape, Environment, Light, LightKind, Lights, SphereLight, Spot, Sun,
+};
 pub use medium::{
     Bounds3, BrickField, DensityField, Emission, Extinction, GlobalMedia, Interaction,
     MajorantSegment, Media, Medium, MediumError, Velocity, VelocityUnit,

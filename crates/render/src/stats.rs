@@ -39,8 +39,10 @@ pub struct Counters {
     pub nee_rays_distant: u64,
     /// ...toward domes...
     pub nee_rays_dome: u64,
-    /// ...and toward sphere, point and spot lights.
+    /// ...toward sphere, point and spot lights...
     pub nee_rays_sphere: u64,
+    /// ...and toward area lights.
+    pub nee_rays_area: u64,
     /// Times a dome was consulted: directions sampled from it for
     /// next-event estimation, and escaped rays looking it up.
     pub dome_samples: u64,
@@ -70,6 +72,7 @@ impl AddAssign for Counters {
         self.nee_rays_distant += o.nee_rays_distant;
         self.nee_rays_dome += o.nee_rays_dome;
         self.nee_rays_sphere += o.nee_rays_sphere;
+        self.nee_rays_area += o.nee_rays_area;
         self.dome_samples += o.dome_samples;
         self.sunward_rays += o.sunward_rays;
         self.equiangular_samples += o.equiangular_samples;

@@ -249,7 +249,8 @@ declare_settings! {
     table lights as "light": LightSpec, LightFlags, each {
     @file_only {
         /// `distant`, `sphere`, `point` (a sphere of radius 0), `spot` (a
-        /// sphere or point in a cone) or `dome`.
+        /// sphere or point in a cone), `rect`, `disk` (one-sided area
+        /// lights) or `dome`.
         kind as "type": String;
         /// The light's name: its light-group layer where no `group` is
         /// given (unnamed lights join `sun`, `sky` or `lights` by kind).
@@ -258,21 +259,33 @@ declare_settings! {
         group: Option<String>;
         /// Where a sphere, point or spot light is.
         position: Option<[f32; 3]>;
-        /// Direction a distant light's light travels, or a spot's axis.
+        /// Direction a distant light's light travels, a spot's axis, or
+        /// the side an area light emits toward.
         direction: Option<[f32; 3]>;
-        /// A sphere or spot light's radius (sphere default 0.5, UsdLux's).
+        /// An area light's second axis (its height's), turned square to
+        /// `direction` (default +Y, or +Z along Y).
+        up: Option<[f32; 3]>;
+        /// A sphere or spot light's radius (sphere default 0.5, UsdLux's),
+        /// or a disk's (default 0.5).
         radius: Option<f32>;
+        /// A rect's width (default 1), or a disk's diameter across, an
+        /// ellipse where it differs from `height`.
+        width: Option<f32>;
+        /// A rect's height (default 1), or a disk's diameter along `up`.
+        height: Option<f32>;
         /// Colour, multiplying `intensity` (default 1,1,1).
         color: Option<[f32; 3]>;
         /// The light's strength (default 1), times `2^exposure` and
         /// `color`: a distant light's irradiance (W/m^2, as `[sun]`), a
-        /// sphere's surface radiance (UsdLux; a point's radiant intensity,
-        /// W/sr), a dome's radiance or its map's multiplier.
+        /// sphere's or area light's surface radiance (UsdLux; a point's
+        /// radiant intensity, W/sr), a dome's radiance or its map's
+        /// multiplier.
         intensity: Option<f32>;
         /// Stops (default 0): `intensity * 2^exposure`.
         exposure: Option<f32>;
-        /// A sphere light's radiance divided by its area `4 pi r^2`, so its
-        /// power does not change with its radius (UsdLux `normalize`).
+        /// A sphere or area light's radiance divided by its area (`4 pi
+        /// r^2` for a sphere), so its power does not change with its size
+        /// (UsdLux `normalize`).
         normalize: Option<bool>;
         /// A distant light's angular diameter in degrees (default 0.53).
         angle: Option<f32>;

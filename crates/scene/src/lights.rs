@@ -6,13 +6,14 @@
 //! writes it: a distant light's irradiance (W/m^2 on a surface facing
 //! it, as `[sun]`), a sphere's surface radiance (divided by its area
 //! `4 pi r^2` where `normalize` is set), a point's radiant intensity
-//! (W/sr; a point has no surface), a dome's radiance or its map's
+//! (W/sr; a point has no surface), an area light's radiance (over its
+//! area where `normalize` is on), a dome's radiance or its map's
 //! multiplier. A sphere of radius `r` and radiance `L` lights the far
 //! field as a point of intensity `L pi r^2`.
 //!
 //! Light groups: a light's `group`, else its `name`, else its kind's
-//! layer (`sun` for distant lights, `sky` for domes, `lights` for sphere
-//! and spot lights); the layers are `sun`, `sky` and `emission`, then
+//! layer (`sun` for distant lights, `sky` for domes, `lights` for sphere,
+//! spot and area lights); the layers are `sun`, `sky` and `emission`, then
 //! the others in the order the lights name them.
 
 use std::f32::consts::PI;
@@ -20,7 +21,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use cirrus_render::compositing::{DEFAULT_LIGHT_GROUPS, MAX_LIGHT_GROUPS};
-use cirrus_render::{EnvMap, Environment, Light, Lights, SphereLight, Spot, Sun};
+use cirrus_render::{
+    AreaLight, AreaShape, EnvMap, Environment, Light, Lights, SphereLight, Spot, Sun,
+};
 use glam::Vec3;
 
 use crate::description::{LightSpec, SceneDescription};
@@ -30,11 +33,13 @@ use crate::error::{Error, Result};
 const DEFAULT_ANGLE_DEGREES: f32 = 0.53;
 /// A sphere light's radius where none is given (UsdLux's fallback).
 const DEFAULT_SPHERE_RADIUS: f32 = 0.5;
+/// A disk light's radius where none is given (UsdLux's fallback).
+const DEFAULT_DISK_RADIUS: f32 = 0.5;
 /// The layer of sphere and spot lights with no name or group.
 const DEFAULT_LOCAL_GROUP: &str = "lights";
 
 /// The kinds of `[[light]]`.
-const KINDS: [&str; 5] = ["distant", "sphere", "point", "spot", "dome"];
+const KINDS: [&str; 7] = ["distant", "sphere", "point", "spot", "rect", "disk", "dome"];
 
 /// The keys each kind takes besides `type`, `name`, `group`, `color`,
 /// `intensity` and `exposure`.
@@ -50,6 +55,23 @@ fn keys_of(kind: &str) -> &'static [&'static str] {
             "normalize",
             "cone_angle",
             "cone_softness",
+        ],
+        "rect" => &[
+            "position",
+            "direction",
+            "up",
+            "width",
+            "height",
+            "normalize",
+        ],
+        "disk" => &[
+            "position",
+            "direction",
+            "up",
+            "radius",
+            "width",
+            "height",
+            "normalize",
         ],
         _ => &["map", "rotation"],
     }
@@ -70,6 +92,9 @@ impl LightSpec {
         let present = [
             ("position", self.position.is_some()),
             ("direction", self.direction.is_some()),
+            ("up", self.up.is_some()),
+            ("width", self.width.is_some()),
+            ("height", self.height.is_some()),
             ("radius", self.radius.is_some()),
             ("normalize", self.normalize.is_some()),
             ("angle", self.angle.is_some()),
@@ -86,8 +111,8 @@ impl LightSpec {
     pub fn check(&self) -> std::result::Result<(), String> {
         let kind = self.kind.as_str();
         if !KINDS.contains(&kind) {
-            let hint = if matches!(kind, "rect" | "disk" | "cylinder") {
-                " (area lights are not rendered yet)"
+            let hint = if kind == "cylinder" {
+                " (cylinder lights are not rendered yet)"
             } else {
                 ""
             };
@@ -124,6 +149,28 @@ impl LightSpec {
         if let Some(r) = self.radius {
             at_least_zero("radius", &[r])?;
         }
+        for (key, size) in [("width", self.width), ("height", self.height)] {
+            if let Some(x) = size {
+                finite(key, &[x])?;
+                if x <= 0.0 {
+                    return Err(format!(
+                        "`{key}` {x} is not positive: an area light needs an area"
+                    ));
+                }
+            }
+        }
+        if let Some(u) = self.up {
+            finite("up", &u)?;
+        }
+        if kind == "disk" && self.radius == Some(0.0) {
+            return Err("`radius` 0: an area light needs an area".into());
+        }
+        if kind == "disk"
+            && self.radius.is_some()
+            && (self.width.is_some() || self.height.is_some())
+        {
+            return Err("give a disk `radius`, or `width` and `height`, not both".into());
+        }
         if let Some(a) = self.angle {
             at_least_zero("angle", &[a])?;
         }
@@ -143,7 +190,12 @@ impl LightSpec {
             "sphere" | "point" | "spot" if self.position.is_none() => {
                 Err(format!("a {kind} light needs `position`"))
             }
-            "spot" if self.direction.is_none() => Err("a spot light needs `direction`".into()),
+            "spot" | "rect" | "disk" if self.direction.is_none() => {
+                Err(format!("a {kind} light needs `direction`"))
+            }
+            "rect" | "disk" if self.position.is_none() => {
+                Err(format!("a {kind} light needs `position`"))
+            }
             "spot" => {
                 let angle = self.cone_angle.ok_or("a spot light needs `cone_angle`")?;
                 if !(angle > 0.0 && angle <= 180.0) {
@@ -191,6 +243,7 @@ impl LightSpec {
                 self.angle.unwrap_or(DEFAULT_ANGLE_DEGREES).to_radians(),
             )
             .into(),
+            "rect" | "disk" => self.area_light(strength).into(),
             "dome" => match &self.map {
                 None => Environment::new(strength).into(),
                 Some(path) => {
@@ -217,6 +270,54 @@ impl LightSpec {
                 .into()
             }
         })
+    }
+}
+
+impl LightSpec {
+    /// A `rect` or `disk` light of strength `strength` (checked).
+    fn area_light(&self, strength: Vec3) -> AreaLight {
+        let v3 = |v: Option<[f32; 3]>| Vec3::from_array(v.unwrap_or_default());
+        let normal = v3(self.direction).normalize();
+        // The height's axis: `up` square to the normal, else +Y, else +Z.
+        let up = [self.up.map(Vec3::from_array), Some(Vec3::Y), Some(Vec3::Z)]
+            .into_iter()
+            .flatten()
+            .map(|u| u - u.dot(normal) * normal)
+            .find(|u| u.length_squared() > 1e-8)
+            .unwrap_or(Vec3::Y)
+            .normalize();
+        let across = up.cross(normal);
+        let (shape, w, h) = match self.kind.as_str() {
+            "rect" => (
+                AreaShape::Rect,
+                self.width.unwrap_or(1.0),
+                self.height.unwrap_or(1.0),
+            ),
+            _ => {
+                let d = 2.0 * self.radius.unwrap_or(DEFAULT_DISK_RADIUS);
+                (
+                    AreaShape::Disk,
+                    self.width.unwrap_or(d),
+                    self.height.unwrap_or(d),
+                )
+            }
+        };
+        let light = |radiance| {
+            AreaLight::new(
+                shape,
+                v3(self.position),
+                0.5 * w * across,
+                0.5 * h * up,
+                normal,
+                radiance,
+            )
+        };
+        let unit = light(strength);
+        if self.normalize.unwrap_or(false) {
+            light(strength / unit.area())
+        } else {
+            unit
+        }
     }
 }
 

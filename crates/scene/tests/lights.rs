@@ -177,7 +177,16 @@ fn bad_lights_are_errors_naming_the_file_and_the_light() {
             "type = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\ncone_angle = 20\ncone_softness = 2",
             "`cone_softness` 2 is not in [0, 1]",
         ),
-        ("type = \"rect\"", "area lights are not rendered yet"),
+        ("type = \"cylinder\"", "cylinder lights are not rendered yet"),
+        (
+            "type = \"rect\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\nwidth = 0",
+            "`width` 0 is not positive: an area light needs an area",
+        ),
+        (
+            "type = \"disk\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\nradius = 0",
+            "`radius` 0: an area light needs an area",
+        ),
+        ("type = \"rect\"\nposition = [0, 0, 0]", "a rect light needs `direction`"),
         ("type = \"lamp\"", "unknown type \"lamp\""),
         ("type = \"distant\"\ndirection = [0, -1, 0]\nradius = 1", "`radius` does not apply to a distant light"),
         ("type = \"point\"\nposition = [0, 0, 0]\ncolor = [1, -1, 1]", "`color` is negative"),
@@ -238,4 +247,40 @@ fn a_sphere_light_stays_where_it_is_against_the_volume_wherever_both_are() {
         (here / there - 1.0).abs() < 1e-3,
         "green sum {here} here, {there} moved"
     );
+}
+
+#[test]
+fn area_lights_take_their_size_orientation_and_normalisation() {
+    let lights = lights_of(
+        r#"
+        [[light]]
+        type = "rect"
+        position = [1, 2, 3]
+        direction = [0, -2, 0]
+        up = [0, 0, 1]
+        width = 2
+        height = 0.5
+        intensity = 3
+        normalize = true
+        [[light]]
+        type = "disk"
+        position = [0, 5, 0]
+        direction = [0, -1, 0]
+        radius = 0.5
+        color = [1, 0.5, 0.25]
+        "#,
+    );
+    let [Light::Area(rect), Light::Area(disk)] = lights.as_slice() else {
+        panic!("{lights:?}")
+    };
+    assert_eq!(rect.area(), 1.0);
+    assert_eq!(rect.normal(), -Vec3::Y);
+    assert_eq!(
+        rect.radiance(),
+        Vec3::splat(3.0),
+        "normalised by its area of 1"
+    );
+    assert_eq!(rect.centre(), Vec3::new(1.0, 2.0, 3.0));
+    assert!((disk.area() - std::f32::consts::PI * 0.25).abs() < 1e-6);
+    assert_eq!(disk.radiance(), Vec3::new(1.0, 0.5, 0.25));
 }

@@ -371,7 +371,25 @@ fn every_light_of_a_stage_is_read_with_its_transform_and_shaping() {
         uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ"]
     }
 "#;
-    let body = format!("{}{lights}", volume("Cloud", "./cloud.vdb", "density"));
+    let area = r#"
+    def RectLight "Panel"
+    {
+        float inputs:width = 2
+        float inputs:height = 3
+        float inputs:intensity = 5
+        double3 xformOp:translate = (0, 10, 0)
+        float3 xformOp:scale = (2, 1, 1)
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:scale"]
+    }
+    def DiskLight "Round"
+    {
+        float inputs:radius = 0.25
+    }
+"#;
+    let body = format!(
+        "{}{lights}{area}",
+        volume("Cloud", "./cloud.vdb", "density")
+    );
     let p = write(&d, "shot.usda", &stage(&body));
     let mut scene = Scene::load(&p).unwrap();
     let w = scene.warnings().join("\n");
@@ -383,7 +401,16 @@ fn every_light_of_a_stage_is_read_with_its_transform_and_shaping() {
     let desc = scene.description();
     assert_eq!(desc.sun.as_ref().unwrap().sun_irradiance, Some([2.0; 3]));
     let l = &desc.lights;
-    assert_eq!(l.len(), 3, "{l:?}");
+    assert_eq!(l.len(), 5, "{l:?}");
+    // The panel: 2 x 3 scaled by 2 in X, emitting along -Z, up +Y.
+    assert_eq!(l[3].kind, "rect");
+    assert_eq!((l[3].width, l[3].height), (Some(4.0), Some(3.0)));
+    assert_eq!(l[3].direction, Some([0.0, 0.0, -1.0]));
+    assert_eq!(l[3].up, Some([0.0, 1.0, 0.0]));
+    assert_eq!(l[3].position, Some([0.0, 10.0, 0.0]));
+    assert_eq!(l[3].color, Some([5.0; 3]));
+    assert_eq!(l[4].kind, "disk");
+    assert_eq!((l[4].width, l[4].height), (Some(0.5), Some(0.5)));
     // The moon: -Z turned 90 degrees about X points along +Y.
     assert_eq!(
         (l[0].kind.as_str(), l[0].name.as_deref()),
@@ -422,6 +449,6 @@ fn every_light_of_a_stage_is_read_with_its_transform_and_shaping() {
     });
     let out = scene.render().unwrap();
     let names = &out.layers.as_ref().unwrap().group_names;
-    assert_eq!(names[3..], ["Moon", "Bulb", "Lamp"]);
+    assert_eq!(names[3..], ["Moon", "Bulb", "Lamp", "Panel", "Round"]);
     assert!(out.stats.counters.nee_rays_sphere > 0);
 }

@@ -235,6 +235,38 @@ def test_point_and_spot_lamps_render_as_cycles_does(addon, tmp_path):
     assert not any("lamps are not rendered" in m for m in warnings), warnings
 
 
+def test_area_lamps_render_as_cycles_does(addon, tmp_path):
+    """A rectangle beside the cloud facing it and an ellipse above it
+    facing down, the sun and sky off."""
+    import mathutils
+
+    scene, _ = build_scene()
+    add_lamps(scene)
+    for name in ("Bulb", "Beam"):
+        scene.objects[name].hide_render = True
+    obj = scene.objects["Cloud"]
+    corners = [obj.matrix_world @ mathutils.Vector(c) for c in obj.bound_box]
+    lo = [min(c[i] for c in corners) for i in range(3)]
+    hi = [max(c[i] for c in corners) for i in range(3)]
+    centre = mathutils.Vector([(a + b) / 2 for a, b in zip(lo, hi)])
+    size = max(b - a for a, b in zip(lo, hi))
+    for name, shape, offset, rotation in (
+        ("Panel", "RECTANGLE", (0.7, -0.2, 0.0), (0.0, math.radians(-90.0), 0.0)),
+        ("Ceiling", "ELLIPSE", (0.0, 0.0, 0.7), (0.0, 0.0, math.radians(30.0))),
+    ):
+        data = bpy.data.lights.new(name, "AREA")
+        data.shape = shape
+        data.size, data.size_y = 0.3 * size, 0.15 * size
+        data.energy = 40.0 * size * size
+        lamp = bpy.data.objects.new(name, data)
+        lamp.location = centre + size * mathutils.Vector(offset)
+        lamp.rotation_euler = rotation
+        scene.collection.objects.link(lamp)
+    assert_renders_as_cycles(addon, scene, tmp_path)
+    warnings = [m for _, m in addon.engine.REPORTS]
+    assert not any("lamps are not rendered" in m for m in warnings), warnings
+
+
 def assert_renders_as_cycles(addon, scene, tmp_path) -> None:
     """Two Cycles and two cirrus renders of `scene` agree within noise on
     the cloud's mean and per block of 16x16 pixels."""

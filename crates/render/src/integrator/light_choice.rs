@@ -54,7 +54,7 @@ use super::per_light::{
     into_shares, lane_shares, lanes_of, raise_to_floors, Lanes, Shares, MIN_PROBABILITY,
 };
 pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
-use crate::light::{Light, Lights, SphereLight};
+use crate::light::{AreaLight, Light, Lights, SphereLight};
 use crate::phase::Phase;
 use crate::sampling::UNIFORM_SPHERE_PDF;
 
@@ -121,6 +121,8 @@ enum Aim {
     Dome,
     /// At a sphere light, its light falling off with distance.
     Sphere(SphereLight),
+    /// At an area light, its light falling off with distance and angle.
+    Area(AreaLight),
 }
 
 /// The light choice of a render: what it weighs each light by, kept flat
@@ -158,6 +160,7 @@ impl LightSampler {
                 Light::Distant(sun) => (Aim::Distant(-sun.direction()), sun.solid_angle()),
                 Light::Dome(_) => (Aim::Dome, 0.0),
                 Light::Sphere(s) => (Aim::Sphere(*s), 0.0),
+                Light::Area(a) => (Aim::Area(*a), 0.0),
             })
             .unzip();
         let luminance: Vec<f32> = lights.iter().map(Light::luminance).collect();
@@ -168,7 +171,7 @@ impl LightSampler {
                 Light::Dome(_) => *l,
                 // Its weight depends on where the vertex is, which the
                 // estimate does not know.
-                Light::Sphere(_) => 0.0,
+                Light::Sphere(_) | Light::Area(_) => 0.0,
             };
         }
         let sampling = sampling.resolve(lights);
@@ -244,6 +247,10 @@ impl LightSampler {
             Aim::Sphere(s) => {
                 let f = phase.eval(dir_in, (s.position() - p).normalize_or_zero());
                 (s.luminance_at(p, self.luminance[i]) * f, 0.0)
+            }
+            Aim::Area(a) => {
+                let f = phase.eval(dir_in, (a.centre() - p).normalize_or_zero());
+                (a.luminance_at(p, self.luminance[i]) * f, 0.0)
             }
         }
     }

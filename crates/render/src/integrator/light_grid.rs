@@ -278,6 +278,21 @@ impl LightGrid {
                     let b = b * inv;
                     *slot = Vec4::new(a * inv, b.x, b.y, b.z);
                 }
+                Light::Area(light) => {
+                    // Toward the centre.
+                    let to = light.centre() - p;
+                    let d = to.length();
+                    slot.x = marched_transmittance::<M, f32>(
+                        medium,
+                        p,
+                        to / d,
+                        d,
+                        step,
+                        ShadowEnd::Cutoff,
+                        rng,
+                        c,
+                    );
+                }
                 Light::Sphere(light) => {
                     // Toward the centre, to the ball's surface.
                     let to = light.position() - p;
@@ -419,7 +434,7 @@ impl LightGrid {
     #[inline]
     fn seen_in(kind: LightKind, slot: Vec4, phase: &Phase, dir: Vec3) -> f32 {
         match kind {
-            LightKind::Distant | LightKind::Sphere => slot.x,
+            LightKind::Distant | LightKind::Sphere | LightKind::Area => slot.x,
             LightKind::Dome => (slot.x + 3.0 * phase.mean_cosine() * slot.yzw().dot(dir)).max(0.0),
         }
     }
@@ -453,6 +468,12 @@ impl LightGrid {
                     let w = to.normalize_or_zero();
                     let f = phase.eval(dir, w) * light.falloff(-w);
                     light.intensity() * (f * seen / d2)
+                }
+                Light::Area(light) => {
+                    // The shape taken for a point at its centre.
+                    let w = (light.centre() - p).normalize_or_zero();
+                    let e = light.luminance_at(p, 1.0);
+                    light.radiance() * (phase.eval(dir, w) * e * seen)
                 }
             };
             s.add(lights.group(i), l);

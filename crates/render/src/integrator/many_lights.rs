@@ -5,7 +5,7 @@
 //! Each light is weighed by its unoccluded light at the vertex as an
 //! isotropic phase function would scatter it (a distant light's irradiance
 //! over `4 pi`, a dome's mean radiance, a sphere light's `I / (4 pi d^2)`
-//! times its spot's falloff), as pbrt-v4's `PowerLightSampler` does with
+//! times its spot's falloff, an area light's `L A cos / (4 pi d^2)`), as pbrt-v4's `PowerLightSampler` does with
 //! distance, or Cycles' light tree does per cluster; a light tree would
 //! find the heavy lights in `log n`, this sum takes `n` multiply-adds per
 //! vertex against a shadow ray's hundreds of lookups. Every light keeps a
@@ -19,7 +19,7 @@
 use glam::Vec3;
 
 use super::per_light::MIN_PROBABILITY;
-use crate::light::{Light, Lights, SphereLight};
+use crate::light::{AreaLight, Light, Lights, SphereLight};
 use crate::sampling::UNIFORM_SPHERE_PDF;
 use crate::spectrum::luminance;
 
@@ -31,6 +31,8 @@ enum Reach {
     /// Falling off from a sphere light, whose intensity's luminance is
     /// given.
     From(SphereLight, f32),
+    /// Falling off from an area light, whose radiance's luminance is given.
+    FromArea(AreaLight, f32),
 }
 
 /// The weighing of many lights.
@@ -51,6 +53,7 @@ impl ManyLights {
                 }
                 Light::Dome(env) => Reach::Everywhere(luminance(env.mean_radiance())),
                 Light::Sphere(s) => Reach::From(*s, luminance(s.intensity()) * UNIFORM_SPHERE_PDF),
+                Light::Area(a) => Reach::FromArea(*a, luminance(a.radiance()) * UNIFORM_SPHERE_PDF),
             })
             .collect();
         Self { reach, uniform }
@@ -69,6 +72,7 @@ impl ManyLights {
         match &self.reach[i] {
             Reach::Everywhere(w) => *w,
             Reach::From(s, l) => s.luminance_at(at, *l),
+            Reach::FromArea(a, l) => a.luminance_at(at, *l),
         }
     }
 

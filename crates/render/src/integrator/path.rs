@@ -90,8 +90,9 @@ pub struct PathTracer<'a, M> {
     pub(super) estimator: TransmittanceEstimator,
     pub(super) max_depth: Option<u32>,
     chromatic: bool,
-    /// Whether any light is a ball that rays can meet (`path_flight.rs`).
-    pub(super) has_balls: bool,
+    /// Whether any light is a surface rays can meet, a ball or an area
+    /// light (`path_flight.rs`).
+    pub(super) has_surfaces: bool,
     /// The sphere, point and spot lights, with their indices.
     pub(super) spheres: Vec<(usize, SphereLight)>,
     /// Whether segments take an equi-angular sample toward them
@@ -120,7 +121,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         max_depth: Option<u32>,
     ) -> Self {
         let lights = lights.pruned();
-        let has_balls = lights.balls().next().is_some();
+        let has_surfaces = lights.any_surface();
         let spheres: Vec<(usize, SphereLight)> = lights
             .iter()
             .enumerate()
@@ -139,7 +140,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
             .map(|(i, _)| i);
         Self {
             medium,
-            has_balls,
+            has_surfaces,
             spheres,
             equiangular,
             sunward_light,

@@ -1,4 +1,5 @@
-//! The path's free flight past the sphere lights it meets.
+//! The path's free flight past the light surfaces it meets: balls of
+//! sphere lights and area lights.
 //!
 //! Lights do not block rays (as in Cycles, pbrt-v4's area lights without
 //! geometry, and UsdLux's lights, which are not geometry): a ray that
@@ -46,7 +47,7 @@ impl<M: Media> PathTracer<'_, M> {
         c: &mut Counters,
     ) -> FreeFlight {
         let ray = path.ray;
-        if !self.has_balls {
+        if !self.has_surfaces {
             return draws.leading(Draw::FreeFlight, vertex, |rng| {
                 sample_free_flight::<S, M>(self.medium, &ray, ray.t_max, &mut path.beta, rng, c)
             });
@@ -85,10 +86,12 @@ impl<M: Media> PathTracer<'_, M> {
     fn next_ball(&self, ray: &Ray, after: Option<(f32, usize)>) -> Option<BallHit> {
         let mut best: Option<BallHit> = None;
         for (i, light) in self.lights.iter().enumerate() {
-            let Light::Sphere(ball) = light else {
-                continue;
+            let hit = match light {
+                Light::Sphere(ball) => ball.hit(ray.origin, ray.dir, ray.t_max),
+                Light::Area(area) => area.hit(ray.origin, ray.dir, ray.t_max),
+                Light::Distant(_) | Light::Dome(_) => None,
             };
-            let Some((t, radiance, pdf)) = ball.hit(ray.origin, ray.dir, ray.t_max) else {
+            let Some((t, radiance, pdf)) = hit else {
                 continue;
             };
             let later = after.is_none_or(|(t0, i0)| (t, i) > (t0, i0));

@@ -95,6 +95,15 @@ impl<M: Media> PathTracer<'_, M> {
                 c.nee_rays_dome += u64::from(s.pdf.is_some_and(|p| p > 0.0));
                 self.light_term::<S>(v, s, pick, shadow, draws, c)
             }
+            Light::Area(area) => {
+                let s = area.sample(v.p, u1, u2);
+                // From behind the light: nothing, no shadow ray.
+                if s.radiance == Vec3::ZERO {
+                    return Vec3::ZERO;
+                }
+                c.nee_rays_area += 1;
+                self.light_term::<S>(v, s, pick, shadow, draws, c)
+            }
             Light::Sphere(_) => unreachable!("sampled above"),
         }
     }

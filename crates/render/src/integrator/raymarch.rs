@@ -66,9 +66,9 @@ impl<'a, M: Media> RayMarcher<'a, M> {
     ) -> LightParts {
         let mut s = LightParts::default();
         for (i, light) in self.lights.iter().enumerate() {
-            // A distant light's disc and a sphere light's cone sampled
-            // uniformly (radiance / pdf is what they deliver); a dome along
-            // a phase-sampled direction.
+            // A distant light's disc, a sphere light's cone and an area
+            // light's shape sampled uniformly (radiance / pdf is what they
+            // deliver); a dome along a phase-sampled direction.
             let (u1, u2) = (rng.uniform(), rng.uniform());
             let (w, f, radiance, t_max) = match light {
                 Light::Distant(sun) => {
@@ -80,6 +80,14 @@ impl<'a, M: Media> RayMarcher<'a, M> {
                     c.dome_samples += 1;
                     let w = phase.sample(dir, u1, u2).0;
                     (w, 1.0, env.eval(w).0, f32::INFINITY)
+                }
+                Light::Area(area) => {
+                    let ls = area.sample(p, u1, u2);
+                    if ls.radiance == Vec3::ZERO {
+                        continue;
+                    }
+                    let f = phase.eval(dir, ls.to_light) / ls.pdf.unwrap_or(1.0);
+                    (ls.to_light, f, ls.radiance, ls.distance)
                 }
                 Light::Sphere(sphere) => {
                     let ls = sphere.sample(p, u1, u2);

@@ -1,17 +1,20 @@
 //! The scene's lights, as a list: distant lights (a direction, optionally
 //! a small disc: the sun, the moon: `distant.rs`), domes (light from every
 //! direction at infinity, constant or an importance-sampled HDR map:
-//! `dome.rs`) and sphere lights (a ball or a point, optionally a spot:
-//! `sphere.rs`). A light that
+//! `dome.rs`), sphere lights (a ball or a point, optionally a spot:
+//! `sphere.rs`) and area lights (a rectangle or a disc, one-sided:
+//! `area.rs`). A light that
 //! delivers nothing is dropped by [`Lights::pruned`] and costs nothing: no
 //! samples, no shadow rays. Each light is tagged with the light group its
 //! contributions go to; the integrators never ask how many lights there
 //! are or of which kind, only for the list and each light's group.
 
+mod area;
 mod distant;
 mod dome;
 mod sphere;
 
+pub use area::{AreaLight, AreaShape};
 pub use distant::Sun;
 pub use dome::Environment;
 pub use sphere::{SphereLight, Spot};
@@ -39,6 +42,14 @@ pub enum Light {
     Dome(Environment),
     /// Light from a ball or a point in the scene, optionally a spot.
     Sphere(SphereLight),
+    /// Light from one side of a rectangle or a disc in the scene.
+    Area(AreaLight),
+}
+
+impl From<AreaLight> for Light {
+    fn from(light: AreaLight) -> Self {
+        Self::Area(light)
+    }
 }
 
 impl From<SphereLight> for Light {
@@ -65,6 +76,7 @@ pub enum LightKind {
     Distant = 0,
     Dome = 1,
     Sphere = 2,
+    Area = 3,
 }
 
 impl Light {
@@ -73,18 +85,21 @@ impl Light {
             Self::Distant(_) => LightKind::Distant,
             Self::Dome(_) => LightKind::Dome,
             Self::Sphere(_) => LightKind::Sphere,
+            Self::Area(_) => LightKind::Area,
         }
     }
 
     /// The luminance of a distant light's irradiance, of a dome's mean
     /// radiance or of a sphere light's intensity: what a light choice
     /// weighs it by (times the phase function toward a distant light, and
-    /// over the squared distance to a sphere light).
+    /// over the squared distance to a sphere light; an area light by its
+    /// radiance).
     pub fn luminance(&self) -> f32 {
         match self {
             Self::Distant(sun) => crate::spectrum::luminance(sun.irradiance()),
             Self::Dome(env) => crate::spectrum::luminance(env.mean_radiance()),
             Self::Sphere(s) => crate::spectrum::luminance(s.intensity()),
+            Self::Area(a) => crate::spectrum::luminance(a.radiance()),
         }
     }
 
@@ -94,6 +109,9 @@ impl Light {
             Self::Distant(sun) => sun.irradiance().max_element() <= 0.0,
             Self::Dome(env) => env.is_black(),
             Self::Sphere(s) => s.intensity().max_element() <= 0.0,
+            Self::Area(a) => {
+                a.radiance().max_element() <= 0.0 || a.area().is_nan() || a.area() <= 0.0
+            }
         }
     }
 
@@ -107,7 +125,7 @@ impl Light {
         match self {
             Self::Distant(sun) => sun.hit(dir),
             Self::Dome(env) => Some(env.eval(dir)),
-            Self::Sphere(_) => None,
+            Self::Sphere(_) | Self::Area(_) => None,
         }
     }
 }
@@ -118,11 +136,11 @@ const DEFAULT_GROUP_DISTANT: u8 = 0;
 const DEFAULT_GROUP_DOME: u8 = 1;
 const DEFAULT_GROUP_EMISSION: u8 = 2;
 
-/// The light group of `kind`'s lights where none is given: sphere lights
-/// join the distant lights' (`sun`) layer.
+/// The light group of `kind`'s lights where none is given: sphere and
+/// area lights join the distant lights' (`sun`) layer.
 fn default_group(kind: LightKind) -> u8 {
     match kind {
-        LightKind::Distant | LightKind::Sphere => DEFAULT_GROUP_DISTANT,
+        LightKind::Distant | LightKind::Sphere | LightKind::Area => DEFAULT_GROUP_DISTANT,
         LightKind::Dome => DEFAULT_GROUP_DOME,
     }
 }
@@ -229,12 +247,13 @@ impl Lights {
         })
     }
 
-    /// The sphere lights of non-zero radius, which rays can hit, with
-    /// their indices.
-    pub fn balls(&self) -> impl Iterator<Item = (usize, &SphereLight)> {
-        self.list.iter().enumerate().filter_map(|(i, l)| match l {
-            Light::Sphere(s) if !s.is_point() => Some((i, s)),
-            _ => None,
+    /// Whether any light is a surface rays can meet: a ball (a sphere
+    /// light of non-zero radius) or an area light.
+    pub fn any_surface(&self) -> bool {
+        self.list.iter().any(|l| match l {
+            Light::Sphere(s) => !s.is_point(),
+            Light::Area(_) => true,
+            Light::Distant(_) | Light::Dome(_) => false,
         })
     }
 
@@ -243,8 +262,10 @@ impl Lights {
     /// precise far from the world's origin); directions are unchanged.
     pub fn relative_to(mut self, origin: glam::DVec3) -> Self {
         for light in &mut self.list {
-            if let Light::Sphere(s) = light {
-                *s = s.moved_to((s.position().as_dvec3() - origin).as_vec3());
+            match light {
+                Light::Sphere(s) => *s = s.moved_to((s.position().as_dvec3() - origin).as_vec3()),
+                Light::Area(a) => *a = a.moved_to((a.centre().as_dvec3() - origin).as_vec3()),
+                Light::Distant(_) | Light::Dome(_) => {}
             }
         }
         self

@@ -1,7 +1,8 @@
 //! UsdLux lights: the first `DistantLight` as the sun and the first
 //! `DomeLight` as the sky (the `[sun]` and `[environment]` tables), every
-//! other distant and dome light and every `SphereLight` (a spot where its
-//! `shaping:cone:angle` is authored) as a `[[light]]`.
+//! other distant and dome light, every `SphereLight` (a spot where its
+//! `shaping:cone:angle` is authored) and every `RectLight` and `DiskLight`
+//! as a `[[light]]`.
 //!
 //! Emission is `intensity x 2^exposure x color` (UsdLux). A distant light's
 //! irradiance (what cirrus's sun is given in) is that value when
@@ -240,4 +241,56 @@ pub fn sphere(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
         r.warn(format!("{path}: an IES profile is not applied"));
     }
     Ok(spec)
+}
+
+/// The `[[light]]` named `name` of the `RectLight` or `DiskLight` at
+/// `path` (`kind` `rect` or `disk`): its shape in the light's XY plane
+/// scaled by its world transform, emitting along its -Z.
+pub fn area(r: &mut Reader, path: &str, name: &str, kind: &str) -> Result<LightSpec> {
+    let p = r.stage.prim(path);
+    let t = r.time.start;
+    let strength = emission(r, path, 1.0)?;
+    let normalize = matches!(
+        value(&p, "inputs:normalize", t)?,
+        Some(openusd::sdf::Value::Bool(true))
+    );
+    let world = world_at(&r.stage, path, t)?;
+    let (x, y) = (
+        world.transform_vector3(DVec3::X),
+        world.transform_vector3(DVec3::Y),
+    );
+    let normal = world.transform_vector3(DVec3::NEG_Z);
+    let (w, h) = if kind == "rect" {
+        let w = input_number(&p, "width", t)?.unwrap_or(1.0);
+        let h = input_number(&p, "height", t)?.unwrap_or(1.0);
+        if attr_asset(&p, "inputs:texture:file", t)?.is_some_and(|(a, _)| !a.is_empty()) {
+            r.warn(format!("{path}: a rect light's texture is not applied"));
+        }
+        (w, h)
+    } else {
+        let d = 2.0 * input_number(&p, "radius", t)?.unwrap_or(0.5);
+        (d, d)
+    };
+    let (w, h) = (w * x.length(), h * y.length());
+    let centre = world.transform_point3(DVec3::ZERO);
+    let finite = centre.is_finite() && normal.is_finite() && y.is_finite();
+    let sized = w > 0.0 && h > 0.0 && normal.length() >= 1e-12 && y.length() >= 1e-12;
+    if !(finite && sized) {
+        return Err(r.error(
+            path,
+            format!("a {kind} light needs a finite transform and a positive size (here {w} x {h})"),
+        ));
+    }
+    Ok(LightSpec {
+        kind: kind.into(),
+        name: Some(name.into()),
+        position: Some(centre.as_vec3().to_array()),
+        direction: Some(normal.as_vec3().to_array()),
+        up: Some(y.as_vec3().to_array()),
+        width: Some(w as f32),
+        height: Some(h as f32),
+        color: Some(strength.to_array()),
+        normalize: Some(normalize),
+        ..Default::default()
+    })
 }

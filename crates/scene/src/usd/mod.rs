@@ -12,7 +12,8 @@
 //!   with its world transform (composed through its parents, instance
 //!   proxies included: each instance of a prototype is its own volume) and
 //!   bound material (`material.rs`);
-//! - every `DistantLight`, `DomeLight` and `SphereLight` (`lights.rs`);
+//! - every `DistantLight`, `DomeLight`, `SphereLight`, `RectLight` and
+//!   `DiskLight` (`lights.rs`);
 //! - the camera the `RenderSettings` name, else the first `Camera`, and the
 //!   settings' resolution (`camera.rs`);
 //! - time: the stage's `startTimeCode`-`endTimeCode` become the frames
@@ -219,6 +220,8 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
                     "DomeLight",
                     "DomeLight_1",
                     "SphereLight",
+                    "RectLight",
+                    "DiskLight",
                     "Camera",
                     "RenderSettings",
                 ]
@@ -228,7 +231,7 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
         .collect();
     if !unsupported.is_empty() {
         r.warn(format!(
-            "{}: not rendered (cirrus renders volumes, distant, dome and sphere lights and a camera): {}",
+            "{}: not rendered (cirrus renders volumes, distant, dome, sphere, rect and disk lights and a camera): {}",
             r.file,
             unsupported.join(", ")
         ));
@@ -248,6 +251,7 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
         &of(&["DistantLight"]),
         &of(&["DomeLight", "DomeLight_1"]),
         &of(&["SphereLight"]),
+        &[of(&["RectLight"]), of(&["DiskLight"])],
         &mut desc,
     )?;
     view(r, &of(&["Camera"]), &of(&["RenderSettings"]), &mut desc)?;
@@ -272,6 +276,7 @@ fn lights(
     suns: &[String],
     domes: &[String],
     spheres: &[String],
+    [rects, disks]: &[Vec<String>; 2],
     desc: &mut SceneDescription,
 ) -> Result<()> {
     desc.sun = Some(match suns.first() {
@@ -298,6 +303,11 @@ fn lights(
     for p in spheres {
         desc.lights.push(lights::sphere(r, p, &name(p))?);
     }
+    for (kind, paths) in [("rect", rects), ("disk", disks)] {
+        for p in paths {
+            desc.lights.push(lights::area(r, p, &name(p), kind)?);
+        }
+    }
     if crate::lights::light_group_names(desc).is_err() {
         r.warn(format!(
             "{}: {} lights are more light-group layers than the film keeps: they share `sun`, `sky` and `lights`",
@@ -315,9 +325,9 @@ fn lights(
             );
         }
     }
-    if suns.is_empty() && domes.is_empty() && spheres.is_empty() {
+    if desc.lights.is_empty() && suns.is_empty() && domes.is_empty() {
         r.warn(format!(
-            "{}: the stage has no DistantLight, DomeLight or SphereLight: the volumes are unlit",
+            "{}: the stage has no DistantLight, DomeLight, SphereLight, RectLight or DiskLight: the volumes are unlit",
             r.file
         ));
     }

@@ -1,5 +1,5 @@
-//! Sphere, point and spot lights in a homogeneous fog, against closed
-//! forms and against each other:
+//! Sphere, point, spot and area lights in a homogeneous fog, against
+//! closed forms and against each other:
 //! - single scattering from a point light in a homogeneous medium is the
 //!   airlight integral (Sun et al. 2005), `sigma_s I / (4 pi) integral
 //!   exp(-sigma_t (t + d(t))) / d(t)^2 dt` along each camera ray, which the
@@ -8,7 +8,10 @@
 //! - a spot light is the same integral times its cone's falloff;
 //!   (each with equi-angular sampling beside the free flight, and the
 //!   point light with free flights alone as well);
-//! - a small ball lights as the point of its intensity `L pi r^2`;
+//! - a small ball lights as the point of its intensity `L pi r^2`, and a
+//!   small rect or disk as the point of intensity `L A cos(theta)`;
+//! - a rect light seen by the camera shows its radiance times the
+//!   transmittance to it;
 //! - a ball seen by the camera shows its radiance times the transmittance
 //!   to it, grey and chromatic (the flight split at the ball);
 //! - with multiple scattering, a large ball's light is the same whether
@@ -18,8 +21,9 @@
 mod common;
 
 use cirrus_render::{
-    render, Bounds3, Camera, ConstantBox, DistanceSampling, Environment, IntegratorKind, Light,
-    LightSampling, Lights, Medium, Rendered, Scene, SphereLight, Spot, Volumes,
+    render, AreaLight, AreaShape, Bounds3, Camera, ConstantBox, DistanceSampling, Environment,
+    IntegratorKind, Light, LightSampling, Lights, Medium, Rendered, Scene, SphereLight, Spot,
+    Volumes,
 };
 use glam::Vec3;
 
@@ -399,4 +403,145 @@ fn sphere_lights_render_the_same_bits_on_any_thread_count_and_cropped() {
     s.crop = Some(common::CROP);
     let part = common::with_threads(3, || render(&scene(), &s));
     common::assert_crop_of("sphere lights", &part, &one, common::CROP);
+}
+
+/// A small area light `size` across at the origin facing `normal`.
+fn small_area(shape: AreaShape, size: f32, normal: Vec3, radiance: Vec3) -> AreaLight {
+    let (u, v) = normal.any_orthonormal_pair();
+    AreaLight::new(
+        shape,
+        Vec3::ZERO,
+        0.5 * size * u,
+        0.5 * size * v,
+        normal,
+        radiance,
+    )
+}
+
+#[test]
+fn a_small_area_light_lights_as_a_point_of_lambertian_intensity() {
+    // Intensity `L A cos(theta)` off its normal; its size 0.05 against
+    // distances of at least 1.4 leaves O((size / d)^2) between them.
+    let normal = Vec3::new(0.3, 1.0, -0.4).normalize();
+    for shape in [AreaShape::Rect, AreaShape::Disk] {
+        let light = small_area(shape, 0.05, normal, INTENSITY);
+        let intensity = INTENSITY * light.area();
+        let out = render_fog(Lights::new([light.into()]), Some(1), 64, 41);
+        assert!(out.stats.counters.nee_rays_area > 0);
+        let expected = airlight_image(intensity, Vec3::ZERO, &|w| w.dot(normal).max(0.0) as f64);
+        assert_matches(&format!("small {shape:?}"), &out, &every(expected));
+    }
+}
+
+#[test]
+fn a_rect_light_seen_through_fog_shows_its_radiance_times_the_transmittance() {
+    let centre = Vec3::new(0.0, 0.0, 3.0);
+    let rect = AreaLight::new(
+        AreaShape::Rect,
+        centre,
+        Vec3::new(1.5, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::NEG_Z,
+        INTENSITY,
+    );
+    let cam = Camera::new(Vec3::new(0.0, 0.0, -4.0), centre, Vec3::Y, 20.0, SIZE, SIZE);
+    let scene = Scene {
+        media: Volumes::from(fog()),
+        camera: cam,
+        lights: Lights::new([rect.into()]),
+    };
+    let spp = 256;
+    let mut s = common::settings(IntegratorKind::Path, spp, 43);
+    s.max_depth = Some(0);
+    let out = render(&scene, &s);
+    let mut inside = 0;
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            // Pixels whose corners all meet the rect: every ray of the
+            // footprint travels the same 7 units of fog to its plane.
+            let all = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+                .iter()
+                .all(|(dx, dy)| {
+                    let r = cam.ray(x as f32 + dx, y as f32 + dy);
+                    rect.hit(r.origin, r.dir, f32::INFINITY).is_some()
+                });
+            if !all {
+                continue;
+            }
+            inside += 1;
+            // Along the view axis the plane is 7 away; off it, a little
+            // more: the footprint's mean of exp(-sigma t).
+            let m = 8;
+            let mut want = 0.0f64;
+            for j in 0..m {
+                for i in 0..m {
+                    let r = cam.ray(
+                        x as f32 + (i as f32 + 0.5) / m as f32,
+                        y as f32 + (j as f32 + 0.5) / m as f32,
+                    );
+                    let (t, _, _) = rect.hit(r.origin, r.dir, f32::INFINITY).unwrap();
+                    want += (-(SIGMA_T * t) as f64).exp();
+                }
+            }
+            let want = want / (m * m) as f64;
+            let got = out.image.pixel(x, y);
+            // Each sample is L times whether its flight passed the fog
+            // (probability T): the standard error is L sqrt(T (1 - T) / n).
+            let se_unit = (want * (1.0 - want) / spp as f64).sqrt();
+            for c in 0..3 {
+                let expected = INTENSITY[c] as f64 * want;
+                let bound = 5.0 * INTENSITY[c] as f64 * se_unit + 1e-4 * expected;
+                assert!(
+                    (got[c] as f64 - expected).abs() <= bound,
+                    "({x}, {y}) channel {c}: {} vs {expected} (bound {bound})",
+                    got[c]
+                );
+            }
+        }
+    }
+    assert!(inside > 100, "{inside} pixels inside the rect");
+}
+
+#[test]
+fn a_large_area_light_renders_alike_with_one_light_picked_and_every_light() {
+    // A 2 x 1.5 rect and a disc of radius 1 close to the view in fog of
+    // albedo 0.8 under a dim sky: phase-sampled rays meet them often, and
+    // their weights against next-event samples carry the pick.
+    let rect = AreaLight::new(
+        AreaShape::Rect,
+        Vec3::new(-1.0, 1.5, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.75),
+        Vec3::new(0.2, -1.0, 0.1),
+        Vec3::new(3.0, 2.5, 2.0),
+    );
+    let disk = AreaLight::new(
+        AreaShape::Disk,
+        Vec3::new(1.5, 2.5, 1.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::NEG_Y,
+        Vec3::new(1.0, 1.5, 3.0),
+    );
+    let lights = || -> Lights {
+        let sky: Light = Environment::new(Vec3::new(0.05, 0.06, 0.08)).into();
+        Lights::new([rect.into(), disk.into(), sky])
+    };
+    let mut s = common::settings(IntegratorKind::Path, 64, 45);
+    s.max_depth = Some(4);
+    s.light_sampling = LightSampling::All;
+    let scene = |lights| Scene {
+        media: Volumes::from(fog()),
+        camera: camera(),
+        lights,
+    };
+    let all = render(&scene(lights()), &s);
+    s.light_sampling = LightSampling::One;
+    s.seed = 46;
+    let one = render(&scene(lights()), &s);
+    assert!(one.stats.counters.nee_rays_area < all.stats.counters.nee_rays_area);
+    for channel in 0..3 {
+        let d = common::differences(&all.image, &one.image, channel);
+        common::assert_pooled_agreement(&format!("large area lights, channel {channel}"), &d);
+    }
 }
