@@ -374,18 +374,26 @@ fn equiangular_sampling_agrees_with_free_flights_in_a_heterogeneous_cloud() {
     }
 }
 
-/// The cloud under a ball, a point spot and a sky, equi-angular sampling
-/// on, every light weighed through the shadow grid: the same bits on 1
-/// and 3 threads, and a crop has the whole image's bits.
+/// The cloud under a ball, a point spot, a rect and a sky, equi-angular
+/// sampling on, every light weighed through the shadow grid: the same bits
+/// on 1 and 3 threads, and a crop has the whole image's bits.
 #[test]
-fn sphere_lights_render_the_same_bits_on_any_thread_count_and_cropped() {
+fn local_lights_render_the_same_bits_on_any_thread_count_and_cropped() {
     let lights = || {
         let ball = SphereLight::new(Vec3::new(0.5, 1.0, 0.3), 0.1, Vec3::new(0.5, 0.4, 0.3));
         let spot = SphereLight::new(Vec3::new(0.2, 0.8, 0.5), 0.0, Vec3::splat(0.4)).with_spot(
             Spot::new(Vec3::new(0.3, -1.0, 0.0), 30f32.to_radians(), 0.2),
         );
         let sky: Light = Environment::new(Vec3::new(0.1, 0.12, 0.2)).into();
-        Lights::new([ball.into(), spot.into(), sky])
+        let panel = AreaLight::new(
+            AreaShape::Rect,
+            Vec3::new(0.5, 0.5, -0.3),
+            Vec3::new(0.2, 0.0, 0.0),
+            Vec3::new(0.0, 0.15, 0.0),
+            Vec3::Z,
+            Vec3::splat(2.0),
+        );
+        Lights::new([ball.into(), spot.into(), sky, panel.into()])
     };
     let scene = || {
         common::scene(
@@ -398,7 +406,11 @@ fn sphere_lights_render_the_same_bits_on_any_thread_count_and_cropped() {
     s.distance_sampling = DistanceSampling::Equiangular;
     let one = common::with_threads(1, || render(&scene(), &s));
     let three = common::with_threads(3, || render(&scene(), &s));
-    assert!(one.stats.counters.equiangular_samples > 0 && one.stats.counters.nee_rays_sphere > 0);
+    let c = &one.stats.counters;
+    assert!(
+        c.equiangular_samples > 0 && c.nee_rays_sphere > 0 && c.nee_rays_area > 0,
+        "{c:?}"
+    );
     assert_eq!(common::image_bits(&one), common::image_bits(&three));
     s.crop = Some(common::CROP);
     let part = common::with_threads(3, || render(&scene(), &s));

@@ -99,7 +99,7 @@ fn a_volume_its_material_and_transform_are_read() {
     let w = scene.warnings().join("\n");
     assert!(w.contains("inputs:roughness"), "{w}");
     assert!(
-        w.contains("no DistantLight, DomeLight or SphereLight"),
+        w.contains("no DistantLight, DomeLight, SphereLight, RectLight or DiskLight"),
         "{w}"
     );
 }
