@@ -278,7 +278,7 @@ fn seen_ball(cam: &Camera, ball: &SphereLight, sigma: Vec3) -> Vec<Option<[f64; 
 #[test]
 fn a_ball_seen_through_fog_shows_its_radiance_times_the_transmittance() {
     let centre = Vec3::new(0.0, 0.0, 3.0);
-    let ball = SphereLight::new(centre, 1.5, INTENSITY);
+    let ball = SphereLight::new(centre, 1.5, INTENSITY).seen_by_camera(true);
     let cam = Camera::new(Vec3::new(0.0, 0.0, -4.0), centre, Vec3::Y, 20.0, SIZE, SIZE);
     let tint = Vec3::new(1.0, 0.6, 0.3);
     for (label, medium) in [
@@ -455,7 +455,8 @@ fn a_rect_light_seen_through_fog_shows_its_radiance_times_the_transmittance() {
         Vec3::new(0.0, 1.0, 0.0),
         Vec3::NEG_Z,
         INTENSITY,
-    );
+    )
+    .seen_by_camera(true);
     let cam = Camera::new(Vec3::new(0.0, 0.0, -4.0), centre, Vec3::Y, 20.0, SIZE, SIZE);
     let scene = Scene {
         media: Volumes::from(fog()),
@@ -556,4 +557,36 @@ fn a_large_area_light_renders_alike_with_one_light_picked_and_every_light() {
         let d = common::differences(&all.image, &one.image, channel);
         common::assert_pooled_agreement(&format!("large area lights, channel {channel}"), &d);
     }
+}
+
+#[test]
+fn lights_hidden_from_the_camera_still_light_the_fog() {
+    // The ball of the test above, not seen by the camera (the default):
+    // at depth 0 no pixel shows its radiance; with single scattering the
+    // fog it lights does.
+    let centre = Vec3::new(0.0, 0.0, 3.0);
+    let cam = Camera::new(Vec3::new(0.0, 0.0, -4.0), centre, Vec3::Y, 20.0, SIZE, SIZE);
+    let render_ball = |visible: bool, depth| {
+        let ball = SphereLight::new(centre, 1.5, INTENSITY).seen_by_camera(visible);
+        let scene = Scene {
+            media: Volumes::from(fog()),
+            camera: cam,
+            lights: Lights::new([ball.into()]),
+        };
+        let mut s = common::settings(IntegratorKind::Path, 16, 9);
+        s.max_depth = Some(depth);
+        s.distance_sampling = DistanceSampling::FreeFlight;
+        render(&scene, &s)
+    };
+    let hidden = render_ball(false, 0);
+    assert!(
+        hidden.image.rgba.iter().all(|p| p[0] == 0.0),
+        "nothing but the ball at depth 0"
+    );
+    assert!(render_ball(true, 0).image.rgba.iter().any(|p| p[0] > 0.0));
+    let lit = render_ball(false, 1);
+    assert!(
+        lit.image.rgba.iter().map(|p| p[1] as f64).sum::<f64>() > 0.0,
+        "the fog is lit"
+    );
 }

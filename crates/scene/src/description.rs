@@ -295,6 +295,10 @@ declare_settings! {
         /// A spot's edge softness in [0, 1] (default 0; UsdLux
         /// `shaping:cone:softness`, Blender's spot blend).
         cone_softness: Option<f32>;
+        /// Whether camera rays see a sphere, spot or area light's surface
+        /// (default false, as Cycles' and Arnold's lamps: the light shows
+        /// in the media it lights; scattered rays always meet it).
+        visible_to_camera: Option<bool>;
         /// A dome's lat-long HDR map (EXR, relative to the scene file).
         map: Option<PathBuf>;
         /// A dome map's rotation about +Y in degrees.

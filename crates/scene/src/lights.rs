@@ -101,6 +101,7 @@ impl LightSpec {
             ("cone_angle", self.cone_angle.is_some()),
             ("cone_softness", self.cone_softness.is_some()),
             ("map", self.map.is_some()),
+            ("visible_to_camera", self.visible_to_camera.is_some()),
             ("rotation", self.rotation.is_some()),
         ];
         present.iter().filter(|p| p.1).map(|p| p.0).collect()
@@ -243,7 +244,10 @@ impl LightSpec {
                 self.angle.unwrap_or(DEFAULT_ANGLE_DEGREES).to_radians(),
             )
             .into(),
-            "rect" | "disk" => self.area_light(strength).into(),
+            "rect" | "disk" => self
+                .area_light(strength)
+                .seen_by_camera(self.visible_to_camera.unwrap_or(false))
+                .into(),
             "dome" => match &self.map {
                 None => Environment::new(strength).into(),
                 Some(path) => {
@@ -258,7 +262,8 @@ impl LightSpec {
                     0.0
                 };
                 let r = self.radius.unwrap_or(default_radius);
-                let light = SphereLight::new(v3(self.position), r, intensity(strength, r, self));
+                let light = SphereLight::new(v3(self.position), r, intensity(strength, r, self))
+                    .seen_by_camera(self.visible_to_camera.unwrap_or(false));
                 match kind {
                     "spot" => light.with_spot(Spot::new(
                         v3(self.direction),

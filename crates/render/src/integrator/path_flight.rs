@@ -12,7 +12,8 @@
 //! track-length estimate of `T L`. A ball seen from a scattering vertex
 //! is weighed against that vertex's next-event samples of it by the power
 //! heuristic with its cone-sampling density times its pick probability;
-//! a camera ray sees it whole.
+//! a camera ray sees it whole, where the light is seen by the camera at
+//! all (off by default: the light shows in what it lights).
 
 use glam::Vec3;
 
@@ -54,8 +55,9 @@ impl<M: Media> PathTracer<'_, M> {
         }
         let mut t0 = 0.0;
         let mut last = None;
+        let camera = matches!(path.escape, Escape::Full);
         loop {
-            let hit = self.next_ball(&ray, last);
+            let hit = self.next_ball(&ray, camera, last);
             let t_end = hit.map_or(ray.t_max, |h| h.t);
             let part = Ray {
                 origin: ray.at(t0),
@@ -81,15 +83,21 @@ impl<M: Media> PathTracer<'_, M> {
         }
     }
 
-    /// The nearest ball `ray` meets after `after` (the distance and light
-    /// of the last one met, which is not met again), within `ray.t_max`.
-    fn next_ball(&self, ray: &Ray, after: Option<(f32, usize)>) -> Option<BallHit> {
+    /// The nearest light surface `ray` (a camera ray where `camera`, which
+    /// meets only those seen by the camera) meets after `after` (the
+    /// distance and light of the last one met, which is not met again),
+    /// within `ray.t_max`.
+    fn next_ball(&self, ray: &Ray, camera: bool, after: Option<(f32, usize)>) -> Option<BallHit> {
         let mut best: Option<BallHit> = None;
         for (i, light) in self.lights.iter().enumerate() {
             let hit = match light {
-                Light::Sphere(ball) => ball.hit(ray.origin, ray.dir, ray.t_max),
-                Light::Area(area) => area.hit(ray.origin, ray.dir, ray.t_max),
-                Light::Distant(_) | Light::Dome(_) => None,
+                Light::Sphere(ball) if !camera || ball.camera_visible() => {
+                    ball.hit(ray.origin, ray.dir, ray.t_max)
+                }
+                Light::Area(area) if !camera || area.camera_visible() => {
+                    area.hit(ray.origin, ray.dir, ray.t_max)
+                }
+                _ => None,
             };
             let Some((t, radiance, pdf)) = hit else {
                 continue;

@@ -36,6 +36,9 @@ pub struct AreaLight {
     shape: AreaShape,
     radiance: Vec3,
     area: f32,
+    /// Whether camera rays see the shape (off by default, as
+    /// [`super::SphereLight`]'s).
+    camera_visible: bool,
 }
 
 impl AreaLight {
@@ -63,6 +66,7 @@ impl AreaLight {
             shape,
             radiance,
             area,
+            camera_visible: false,
         }
     }
 
@@ -84,6 +88,19 @@ impl AreaLight {
 
     pub fn shape(&self) -> AreaShape {
         self.shape
+    }
+
+    /// The same light, seen by camera rays where `visible`.
+    pub fn seen_by_camera(self, visible: bool) -> Self {
+        Self {
+            camera_visible: visible,
+            ..self
+        }
+    }
+
+    /// Whether camera rays see it.
+    pub fn camera_visible(&self) -> bool {
+        self.camera_visible
     }
 
     /// The same light moved to `centre`.

@@ -77,6 +77,10 @@ pub struct SphereLight {
     /// Radiant intensity, W/sr per channel.
     intensity: Vec3,
     spot: Option<Spot>,
+    /// Whether camera rays see the ball (off by default, as Arnold's and
+    /// Cycles' lamps: the light shows in the media it lights, not as a
+    /// bright disc in the image); scattered rays always meet it.
+    camera_visible: bool,
 }
 
 impl SphereLight {
@@ -89,7 +93,21 @@ impl SphereLight {
             radius: radius.max(0.0),
             intensity,
             spot: None,
+            camera_visible: false,
         }
+    }
+
+    /// The same light, seen by camera rays where `visible`.
+    pub fn seen_by_camera(self, visible: bool) -> Self {
+        Self {
+            camera_visible: visible,
+            ..self
+        }
+    }
+
+    /// Whether camera rays see it.
+    pub fn camera_visible(&self) -> bool {
+        self.camera_visible
     }
 
     /// The same light shaped by `spot`'s cone.
