@@ -22,8 +22,8 @@ mod common;
 
 use cirrus_render::{
     render, AreaLight, AreaShape, Bounds3, Camera, ConstantBox, DistanceSampling, Environment,
-    IntegratorKind, Light, LightSampling, Lights, Medium, Rendered, Scene, SphereLight, Spot,
-    Volumes,
+    IntegratorKind, Light, LightSampling, Lights, Medium, RenderSettings, Rendered, Scene,
+    SphereLight, Spot, Volumes,
 };
 use glam::Vec3;
 
@@ -322,27 +322,44 @@ fn a_large_ball_renders_alike_with_one_light_picked_and_every_light() {
     // albedo 0.8 under a dim sky: phase-sampled rays meet the ball often
     // and their weights against its next-event samples carry the pick.
     let ball = SphereLight::new(Vec3::new(0.0, 1.0, 0.0), 1.0, INTENSITY);
-    let lights = || -> Lights {
-        let sky: Light = Environment::new(Vec3::new(0.05, 0.06, 0.08)).into();
-        Lights::new([ball.into(), sky])
-    };
-    let mut s = common::settings(IntegratorKind::Path, 64, 21);
-    s.max_depth = Some(4);
-    s.light_sampling = LightSampling::All;
-    let scene = |lights| Scene {
-        media: Volumes::from(fog()),
-        camera: camera(),
-        lights,
-    };
-    let all = render(&scene(lights()), &s);
-    s.light_sampling = LightSampling::One;
-    s.seed = 22;
-    let one = render(&scene(lights()), &s);
+    let (all, one) = one_light_and_every_light("large ball", [ball.into()], 21);
     assert!(one.stats.counters.nee_rays_sphere < all.stats.counters.nee_rays_sphere);
+}
+
+/// Renders the fog under `lights` and a dim sky, up to 4 scattering
+/// events, sampling every light (seed `seed`) and one light per vertex
+/// (seed `seed + 1`), and checks they agree; returns both.
+fn one_light_and_every_light<const N: usize>(
+    label: &str,
+    lights: [Light; N],
+    seed: u64,
+) -> (Rendered, Rendered) {
+    let sky: Light = Environment::new(Vec3::new(0.05, 0.06, 0.08)).into();
+    let lights = Lights::new(lights.into_iter().chain([sky]));
+    let mut s = common::settings(IntegratorKind::Path, 64, seed);
+    s.max_depth = Some(4);
+    let render_with = |sampling, seed| {
+        let scene = Scene {
+            media: Volumes::from(fog()),
+            camera: camera(),
+            lights: lights.clone(),
+        };
+        render(
+            &scene,
+            &RenderSettings {
+                light_sampling: sampling,
+                seed,
+                ..s.clone()
+            },
+        )
+    };
+    let all = render_with(LightSampling::All, seed);
+    let one = render_with(LightSampling::One, seed + 1);
     for channel in 0..3 {
         let d = common::differences(&all.image, &one.image, channel);
-        common::assert_pooled_agreement(&format!("large ball, channel {channel}"), &d);
+        common::assert_pooled_agreement(&format!("{label}, channel {channel}"), &d);
     }
+    (all, one)
 }
 
 /// A point light inside the cloud, and a spot light above it shining
@@ -536,27 +553,8 @@ fn a_large_area_light_renders_alike_with_one_light_picked_and_every_light() {
         Vec3::NEG_Y,
         Vec3::new(1.0, 1.5, 3.0),
     );
-    let lights = || -> Lights {
-        let sky: Light = Environment::new(Vec3::new(0.05, 0.06, 0.08)).into();
-        Lights::new([rect.into(), disk.into(), sky])
-    };
-    let mut s = common::settings(IntegratorKind::Path, 64, 45);
-    s.max_depth = Some(4);
-    s.light_sampling = LightSampling::All;
-    let scene = |lights| Scene {
-        media: Volumes::from(fog()),
-        camera: camera(),
-        lights,
-    };
-    let all = render(&scene(lights()), &s);
-    s.light_sampling = LightSampling::One;
-    s.seed = 46;
-    let one = render(&scene(lights()), &s);
+    let (all, one) = one_light_and_every_light("large area lights", [rect.into(), disk.into()], 45);
     assert!(one.stats.counters.nee_rays_area < all.stats.counters.nee_rays_area);
-    for channel in 0..3 {
-        let d = common::differences(&all.image, &one.image, channel);
-        common::assert_pooled_agreement(&format!("large area lights, channel {channel}"), &d);
-    }
 }
 
 #[test]

@@ -81,16 +81,10 @@ impl<'a, M: Media> RayMarcher<'a, M> {
                     let w = phase.sample(dir, u1, u2).0;
                     (w, 1.0, env.eval(w).0, f32::INFINITY)
                 }
-                Light::Area(area) => {
-                    let ls = area.sample(p, u1, u2);
-                    if ls.radiance == Vec3::ZERO {
+                Light::Sphere(_) | Light::Area(_) => {
+                    let Some(ls) = light.sample_from(p, u1, u2) else {
                         continue;
-                    }
-                    let f = phase.eval(dir, ls.to_light) / ls.pdf.unwrap_or(1.0);
-                    (ls.to_light, f, ls.radiance, ls.distance)
-                }
-                Light::Sphere(sphere) => {
-                    let ls = sphere.sample(p, u1, u2);
+                    };
                     if ls.radiance == Vec3::ZERO {
                         continue;
                     }

@@ -115,6 +115,17 @@ impl Light {
         }
     }
 
+    /// A sample from `p` of a light in the scene (a sphere or area
+    /// light), `None` for lights at infinity (sampled by direction alone).
+    #[inline]
+    pub fn sample_from(&self, p: Vec3, u1: f32, u2: f32) -> Option<LightSample> {
+        match self {
+            Self::Sphere(s) => Some(s.sample(p, u1, u2)),
+            Self::Area(a) => Some(a.sample(p, u1, u2)),
+            Self::Distant(_) | Self::Dome(_) => None,
+        }
+    }
+
     /// Radiance reaching a ray that escapes along `dir` and the density
     /// with which [`sample`](Self::sample) would have drawn `dir`; `None`
     /// where the light is not seen that way (outside a disc, or a delta
