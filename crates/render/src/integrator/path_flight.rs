@@ -3,15 +3,16 @@
 //!
 //! Lights do not block rays (as in Cycles, pbrt-v4's area lights without
 //! geometry, and UsdLux's lights, which are not geometry): a ray that
-//! reaches a ball of light before its next real collision gathers the
-//! ball's radiance there and flies on. The flight is split at each ball
-//! it meets in turn; delta tracking is memoryless, so a flight restarted
-//! at the ball samples the same collision density, and the ball is
+//! reaches a light surface before its next real collision gathers its
+//! radiance there and flies on. The flight is split at each surface it
+//! meets in turn; delta tracking is memoryless, so a flight restarted
+//! at the surface samples the same collision density, and the surface is
 //! reached with probability (or, for chromatic media, spectral tracking's
 //! weight) the transmittance to it, which makes the gathered light the
-//! track-length estimate of `T L`. A ball seen from a scattering vertex
+//! track-length estimate of `T L`. A surface seen from a scattering vertex
 //! is weighed against that vertex's next-event samples of it by the power
-//! heuristic with its cone-sampling density times its pick probability;
+//! heuristic with its sampling density (a ball's cone, an area light's
+//! shape) times its pick probability;
 //! a camera ray sees it whole, where the light is seen by the camera at
 //! all (off by default: the light shows in what it lights).
 
@@ -27,9 +28,10 @@ use crate::spectrum::Spectrum;
 use crate::stats::Counters;
 use crate::tracking::{sample_free_flight, FreeFlight};
 
-/// A ball of light a ray meets: its light's index, where and what it sees.
+/// A light surface (a ball or an area light) a ray meets: its light's
+/// index, where and what it sees.
 #[derive(Clone, Copy, Debug)]
-struct BallHit {
+struct SurfaceHit {
     light: usize,
     t: f32,
     radiance: Vec3,
@@ -38,7 +40,7 @@ struct BallHit {
 
 impl<M: Media> PathTracer<'_, M> {
     /// The free flight of path vertex `vertex` along `path.ray`, gathering
-    /// the light of the balls it passes.
+    /// the light of the light surfaces it passes.
     #[inline]
     pub(super) fn fly<S: Spectrum>(
         &self,
@@ -57,7 +59,7 @@ impl<M: Media> PathTracer<'_, M> {
         let mut last = None;
         let camera = matches!(path.escape, Escape::Full);
         loop {
-            let hit = self.next_ball(&ray, camera, last);
+            let hit = self.next_surface(&ray, camera, last);
             let t_end = hit.map_or(ray.t_max, |h| h.t);
             let part = Ray {
                 origin: ray.at(t0),
@@ -73,7 +75,7 @@ impl<M: Media> PathTracer<'_, M> {
             };
             match (flight, hit) {
                 (FreeFlight::Escaped, Some(h)) => {
-                    self.gather_ball(path, &h);
+                    self.gather_surface(path, &h);
                     t0 = h.t;
                     last = Some((h.t, h.light));
                 }
@@ -87,8 +89,13 @@ impl<M: Media> PathTracer<'_, M> {
     /// meets only those seen by the camera) meets after `after` (the
     /// distance and light of the last one met, which is not met again),
     /// within `ray.t_max`.
-    fn next_ball(&self, ray: &Ray, camera: bool, after: Option<(f32, usize)>) -> Option<BallHit> {
-        let mut best: Option<BallHit> = None;
+    fn next_surface(
+        &self,
+        ray: &Ray,
+        camera: bool,
+        after: Option<(f32, usize)>,
+    ) -> Option<SurfaceHit> {
+        let mut best: Option<SurfaceHit> = None;
         for (i, light) in self.lights.iter().enumerate() {
             let hit = match light {
                 Light::Sphere(ball) if !camera || ball.camera_visible() => {
@@ -104,7 +111,7 @@ impl<M: Media> PathTracer<'_, M> {
             };
             let later = after.is_none_or(|(t0, i0)| (t, i) > (t0, i0));
             if later && best.is_none_or(|b| (t, i) < (b.t, b.light)) {
-                best = Some(BallHit {
+                best = Some(SurfaceHit {
                     light: i,
                     t,
                     radiance,
@@ -115,9 +122,9 @@ impl<M: Media> PathTracer<'_, M> {
         best
     }
 
-    /// Adds ball `h`'s light, seen along the path's ray, MIS-weighted
+    /// Adds surface `h`'s light, seen along the path's ray, MIS-weighted
     /// against next-event estimation at the ray's origin.
-    fn gather_ball(&self, path: &mut Path, h: &BallHit) {
+    fn gather_surface(&self, path: &mut Path, h: &SurfaceHit) {
         // After the last scattering event only emission is gathered, and
         // a depth holdout hides what lies behind it (`t_max` above).
         if path.emission_only {
