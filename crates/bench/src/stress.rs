@@ -20,7 +20,7 @@
 
 use crate::BenchResult;
 use cirrus_bricks::{convert, BrickVolume, Precision};
-use cirrus_render::medium::BrickField;
+use cirrus_kernel::medium::BrickField;
 use cirrus_render::{
     render, Budget, Camera, Environment, Lights, Medium, RenderSettings, RenderStats, Scene, Sun,
     TransmittanceEstimator, Volumes,

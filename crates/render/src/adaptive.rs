@@ -21,8 +21,8 @@
 //! threshold falls (they are of order `1/n` relative to the mean); see the
 //! pooled test in `tests/adaptive.rs` for a measured bound.
 
-use crate::error::{Error, Result};
 use crate::film::{Film, PixelAccumulator};
+use cirrus_kernel::{Error, Result};
 
 /// Below this mean intensity (in the image's radiance units) the error is
 /// taken relative to the floor instead: a black pixel needs only its

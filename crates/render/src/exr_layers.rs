@@ -17,9 +17,9 @@ use std::path::Path;
 
 pub use crate::exr_read::{read_channels, ExrChannels};
 
-use crate::error::{Error, Result};
 use crate::film::AovImage;
 use crate::render::Rendered;
+use cirrus_kernel::{Error, Result};
 
 /// The AOV layers a file can carry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]

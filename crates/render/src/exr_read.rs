@@ -1,8 +1,10 @@
-//! Reading an EXR's channels back: a crop tile, a depth image.
+//! Reading EXR files: a crop tile's channels, a depth image, an
+//! environment map; and the `exr` crate's errors as the renderer's.
 
 use std::path::Path;
 
-use crate::error::{exr_error, Result};
+use cirrus_kernel::{EnvMap, Error, Result};
+use glam::Vec3;
 
 /// What [`read_channels`] returns.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,7 +48,7 @@ pub fn read_channels(path: &Path) -> Result<ExrChannels> {
         .collect();
     attributes.sort();
     if dw.position != Vec2(0, 0) {
-        return Err(crate::error::Error::format(
+        return Err(cirrus_kernel::Error::format(
             path,
             "display window must start at 0,0",
         ));
@@ -74,4 +76,34 @@ pub fn read_channels(path: &Path) -> Result<ExrChannels> {
         channels,
         attributes,
     })
+}
+
+/// An environment map from the first RGB(A) layer of an OpenEXR file (alpha ignored).
+pub fn read_env_map(path: &Path, rotation_degrees: f32) -> Result<EnvMap> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |res: Vec2<usize>, _| (res.width(), vec![Vec3::ZERO; res.area()]),
+        |(w, px): &mut (usize, Vec<Vec3>),
+         pos: Vec2<usize>,
+         (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
+        },
+    )
+    .map_err(|e| exr_error(path, e))?;
+    let (w, px) = image.layer_data.channel_data.pixels;
+    let h = px.len() / w.max(1);
+    if w == 0 || h == 0 {
+        return Err(cirrus_kernel::Error::format(path, "empty image"));
+    }
+    Ok(EnvMap::new(w, h, px, rotation_degrees))
+}
+
+/// An error of the `exr` crate reading or writing `path`: its I/O errors
+/// are the file's, everything else is the file's format.
+pub(crate) fn exr_error(path: &Path, e: exr::error::Error) -> Error {
+    match e {
+        exr::error::Error::Io(source) => Error::io(path, source),
+        other => Error::format(path, other),
+    }
 }

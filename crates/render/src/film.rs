@@ -4,8 +4,8 @@
 use glam::Vec3;
 
 use crate::compositing::{Compositing, Layers, TileLayers};
-use crate::integrator::{AovSample, Sample};
-use crate::stats::Counters;
+use cirrus_kernel::integrator::{AovSample, Sample};
+use cirrus_kernel::Counters;
 
 /// A finished image (or its crop window, see [`Rendered`](crate::Rendered)):
 /// per-pixel mean RGBA (alpha = 1 - camera-ray transmittance), the
@@ -123,7 +123,7 @@ pub struct AovImage {
     pub samples: Vec<f32>,
 }
 
-pub use crate::compositing::deep::NO_DEPTH;
+use crate::compositing::deep::NO_DEPTH;
 
 /// Running means of the AOV parts of one pixel's samples.
 #[derive(Clone, Copy, Debug, Default)]

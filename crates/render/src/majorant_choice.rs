@@ -20,15 +20,16 @@
 //! crop still merges bit-identically), and counts, unlike timings, do not
 //! depend on the machine's load.
 
-use crate::camera::Camera;
-use crate::integrator::CameraSampler;
-use crate::light::Lights;
-use crate::medium::{GlobalMedia, Media};
 use crate::path_setup::{path_tracer, ShadowGrid};
 use crate::pixel_sampler::PixelSampler;
-use crate::sampling::{Rng, SampleStream};
-use crate::scene::{MajorantMode, RenderSettings};
-use crate::stats::Counters;
+use crate::scene::RenderSettings;
+use cirrus_kernel::integrator::CameraSampler;
+use cirrus_kernel::light::Lights;
+use cirrus_kernel::medium::{GlobalMedia, Media};
+use cirrus_kernel::sampling::{Rng, SampleStream};
+use cirrus_kernel::Camera;
+use cirrus_kernel::Counters;
+use cirrus_kernel::MajorantMode;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 

@@ -4,10 +4,10 @@
 
 use std::time::Instant;
 
-use crate::integrator::{IntegratorKind, LightGrid, LightSampling, PathTracer};
-use crate::light::Lights;
-use crate::medium::Media;
 use crate::scene::RenderSettings;
+use cirrus_kernel::integrator::{IntegratorKind, LightGrid, LightSampling, PathTracer};
+use cirrus_kernel::light::Lights;
+use cirrus_kernel::medium::Media;
 
 /// The path tracer `settings` ask for over `medium`, picking lights through
 /// `shadows` where it picks one per vertex: what the render traces and

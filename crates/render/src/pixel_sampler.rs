@@ -3,12 +3,12 @@
 //! passes and the majorant probe draw their camera rays here, so both
 //! trace what the image is made of.
 
-use crate::camera::Camera;
 use crate::compositing::DepthHoldout;
-use crate::ray::Ray;
-use crate::sampling::{Draw, SampleStream};
 use crate::scene::RenderSettings;
-use crate::shutter::Shutter;
+use cirrus_kernel::sampling::{Draw, SampleStream};
+use cirrus_kernel::Camera;
+use cirrus_kernel::Ray;
+use cirrus_kernel::Shutter;
 
 /// The camera rays of one render.
 #[derive(Clone, Copy)]

@@ -8,19 +8,22 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::adaptive::{Adaptive, Selection};
-use crate::camera::Camera;
 use crate::compositing::Layers;
 use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Halves, Image, Tile};
-use crate::integrator::{CameraSampler, IntegratorKind, LightGrid, RayMarcher, TwoPassMarcher};
-use crate::light::Lights;
 use crate::majorant_choice;
-use crate::medium::{GlobalMedia, Media};
 use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGrid};
 use crate::pixel_sampler::PixelSampler;
-use crate::sampling::{SampleStream, SamplerKind};
-use crate::scene::{Budget, Crop, MajorantMode, RenderSettings, Scene};
-use crate::stats::{Counters, RenderStats};
+use crate::scene::{Budget, Crop, RenderSettings, Scene};
+use crate::stats::RenderStats;
+use cirrus_kernel::integrator::{
+    CameraSampler, IntegratorKind, LightGrid, RayMarcher, TwoPassMarcher,
+};
+use cirrus_kernel::light::Lights;
+use cirrus_kernel::medium::{GlobalMedia, Media};
+use cirrus_kernel::sampling::{SampleStream, SamplerKind};
+use cirrus_kernel::Camera;
+use cirrus_kernel::{Counters, MajorantMode};
 
 /// A finished render.
 pub struct Rendered {

@@ -3,17 +3,14 @@
 
 use std::sync::Arc;
 
+use cirrus_kernel::{
+    Camera, DistanceSampling, Error, IntegratorKind, LightGridSettings, LightSampling, Lights,
+    MajorantMode, Result, SamplerKind, Shutter, Sunward, TransmittanceEstimator,
+};
+
 use crate::adaptive::Adaptive;
-use crate::camera::Camera;
 use crate::compositing::Compositing;
 use crate::control::RenderControl;
-use crate::error::{Error, Result};
-use crate::integrator::{DistanceSampling, LightSampling, Sunward};
-use crate::integrator::{IntegratorKind, LightGridSettings};
-use crate::light::Lights;
-use crate::sampling::SamplerKind;
-use crate::shutter::Shutter;
-use crate::tracking::TransmittanceEstimator;
 
 /// What is rendered, all in render space: the media (a lone medium or
 /// several, as [`Volumes`](crate::Volumes)), a camera and lights at
@@ -23,22 +20,6 @@ pub struct Scene<M> {
     pub camera: Camera,
     pub lights: Lights,
 }
-
-settings_enum! {
-    /// Which majorants the trackers use.
-    pub enum MajorantMode {
-        /// Whichever of the two a probe of the scene finds cheaper
-        /// ([`crate::majorant_choice`]).
-        #[default]
-        Auto = "auto",
-        /// The field's own local segments (its hierarchy or grid).
-        Hierarchy = "hierarchy",
-        /// One global majorant over the field's bounds (Mitsuba 3 style).
-        Global = "global",
-    }
-}
-
-impl MajorantMode {}
 
 /// How long to render.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -10,11 +10,12 @@
 
 mod common;
 
-use cirrus_render::medium::{Extinction, Interaction, Lattice};
-use cirrus_render::tracking::{sample_free_flight, transmittance, FreeFlight};
+use cirrus_kernel::medium::{Extinction, Interaction, Lattice};
+use cirrus_kernel::tracking::{sample_free_flight, transmittance, FreeFlight};
+use cirrus_kernel::{Ray, Rng, Spectrum};
 use cirrus_render::{
-    render, Bounds3, Camera, ConstantBox, Counters, IntegratorKind, Lights, Media, Medium, Ray,
-    Rng, Scene, Spectrum, TransmittanceEstimator, Volumes,
+    render, Bounds3, Camera, ConstantBox, Counters, IntegratorKind, Lights, Media, Medium, Scene,
+    TransmittanceEstimator, Volumes,
 };
 use common::render_through;
 use glam::Vec3;

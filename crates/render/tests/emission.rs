@@ -5,7 +5,7 @@
 
 mod common;
 
-use cirrus_render::blackbody::blackbody_rgb;
+use cirrus_kernel::blackbody::blackbody_rgb;
 use cirrus_render::Bounds3;
 use cirrus_render::{
     Blackbody, Camera, ConstantBox, Emission, IntegratorKind, Lights, Medium, Volumes,
@@ -73,7 +73,7 @@ fn check(label: &str, emission: Emission<ConstantBox>, le: Vec3) {
         assert_eq!(aovs.samples[i], spp as f32);
         let d = aovs.depth[i];
         assert!(
-            d == cirrus_render::film::NO_DEPTH || (2.0..=4.5).contains(&d),
+            d == cirrus_render::compositing::deep::NO_DEPTH || (2.0..=4.5).contains(&d),
             "{label}: depth {d} at pixel {i}"
         );
     }

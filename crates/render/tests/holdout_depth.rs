@@ -11,7 +11,7 @@ mod common;
 
 use std::sync::Arc;
 
-use cirrus_render::medium::{Bounds3, DensityField};
+use cirrus_kernel::medium::{Bounds3, DensityField};
 use cirrus_render::{
     render, Camera, DepthHoldout, GridField, IntegratorKind, Lights, Medium, Rendered, Scene, Sun,
 };

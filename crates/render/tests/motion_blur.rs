@@ -6,11 +6,12 @@
 use std::sync::Arc;
 
 use cirrus_bricks::{convert_tree, BrickVolume, Precision, VelocityGrid};
-use cirrus_render::medium::BrickField;
-use cirrus_render::tracking::ratio_tracking;
+use cirrus_kernel::medium::BrickField;
+use cirrus_kernel::tracking::ratio_tracking;
+use cirrus_kernel::{Ray, Rng};
 use cirrus_render::{
-    render, Budget, Camera, Counters, DensityField, Environment, Lights, Medium, Ray,
-    RenderSettings, Rng, Scene, Shutter, Velocity, VelocityUnit, Volumes,
+    render, Budget, Camera, Counters, DensityField, Environment, Lights, Medium, RenderSettings,
+    Scene, Shutter, Velocity, VelocityUnit, Volumes,
 };
 use cirrus_vdb::{Coord, Tree};
 use glam::{DMat4, DVec3, Vec3};

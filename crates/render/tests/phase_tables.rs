@@ -5,7 +5,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use cirrus_render::phase::MAX_TABLE_ROWS;
+use cirrus_kernel::phase::MAX_TABLE_ROWS;
 use cirrus_render::{render, IntegratorKind, Lights, Phase};
 use glam::Vec3;
 

@@ -79,7 +79,8 @@ fn ray_marchers_converge_to_single_scattering() {
 
 #[test]
 fn light_grid_stores_only_bricks_near_density() {
-    use cirrus_render::{Counters, LightGrid, LightGridSettings};
+    use cirrus_kernel::LightGrid;
+    use cirrus_render::{Counters, LightGridSettings};
     // 64^3 voxels with density only in a 6^3 corner: at one voxel per cell
     // the lattice has 9^3 bricks, of which the corner touches a few.
     let field = GridField::from_fn([64, 64, 64], Vec3::ZERO, 1.0 / 64.0, 8, |i, j, k| {

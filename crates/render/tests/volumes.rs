@@ -3,9 +3,10 @@
 
 mod common;
 
-use cirrus_render::medium::Scaled;
+use cirrus_kernel::medium::Scaled;
+use cirrus_kernel::{Ray, Rng};
 use cirrus_render::{
-    render, ConstantBox, DensityField, IntegratorKind, Lights, Media, Medium, Ray, Rng,
+    render, ConstantBox, DensityField, IntegratorKind, Lights, Media, Medium,
     TransmittanceEstimator, Volumes,
 };
 use glam::Vec3;
@@ -90,7 +91,7 @@ fn one_instance_walks_its_own_segments() {
     let mut segments = 0;
     for _ in 0..200 {
         let o = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
-        let d = cirrus_render::sampling::uniform_sphere(rng.uniform(), rng.uniform());
+        let d = cirrus_kernel::sampling::uniform_sphere(rng.uniform(), rng.uniform());
         let ours: Vec<_> = volumes.majorants(o, d, 0.0, f32::INFINITY).collect();
         let own: Vec<_> = Scaled::new(field.segments(o, d, 0.0, f32::INFINITY), 6.0).collect();
         assert_eq!(ours, own);

@@ -21,9 +21,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use cirrus_render::compositing::{DEFAULT_LIGHT_GROUPS, MAX_LIGHT_GROUPS};
-use cirrus_render::{
-    AreaLight, AreaShape, EnvMap, Environment, Light, Lights, SphereLight, Spot, Sun,
-};
+use cirrus_render::{AreaLight, AreaShape, Environment, Light, Lights, SphereLight, Spot, Sun};
 use glam::Vec3;
 
 use crate::description::{LightSpec, SceneDescription};
@@ -251,7 +249,7 @@ impl LightSpec {
             "dome" => match &self.map {
                 None => Environment::new(strength).into(),
                 Some(path) => {
-                    let map = EnvMap::read_exr(path, self.rotation.unwrap_or(0.0))?;
+                    let map = cirrus_render::read_env_map(path, self.rotation.unwrap_or(0.0))?;
                     Environment::from_map(Arc::new(map), strength).into()
                 }
             },
@@ -395,7 +393,7 @@ pub fn lights(desc: &SceneDescription) -> Result<Lights> {
         let light = match &env.env_map {
             None => Environment::new(Vec3::from_array(env.env_radiance())),
             Some(path) => {
-                let map = EnvMap::read_exr(path, env.env_rotation())?;
+                let map = cirrus_render::read_env_map(path, env.env_rotation())?;
                 Environment::from_map(Arc::new(map), Vec3::splat(env.env_intensity()))
             }
         };

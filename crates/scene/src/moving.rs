@@ -11,8 +11,8 @@
 use std::sync::Arc;
 
 use cirrus_bricks::{BrickVolume, DBounds3};
-use cirrus_render::medium::BrickField;
-use cirrus_render::transform_motion::{MovingField, PoseTable};
+use cirrus_kernel::medium::BrickField;
+use cirrus_kernel::transform_motion::{MovingField, PoseTable};
 use cirrus_render::{Camera, CameraMotion, CameraPose, Emission, Medium};
 use glam::{DMat4, DVec3, Vec3};
 
@@ -228,7 +228,7 @@ pub fn camera(desc: &SceneDescription, s: &SceneSettings, centre: DVec3) -> Resu
 
 /// At most the camera's pose capacity, evenly chosen, ends kept.
 fn resample(poses: &[(f32, DVec3, glam::DQuat)]) -> Vec<(f32, DVec3, glam::DQuat)> {
-    let max = cirrus_render::camera_motion::MAX_POSES;
+    let max = cirrus_kernel::camera_motion::MAX_POSES;
     if poses.len() <= max {
         return poses.to_vec();
     }

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use cirrus_bricks::{BrickVolume, DBounds3, Precision, VelocityGrid};
-use cirrus_render::medium::BrickField;
-use cirrus_render::medium::Extinction;
+use cirrus_kernel::medium::BrickField;
+use cirrus_kernel::medium::Extinction;
 use cirrus_render::{
     Blackbody, DensityField, Emission, IntegratorKind, Medium, Phase, Shutter, Velocity,
     VelocityUnit,
@@ -26,7 +26,7 @@ use crate::grids::{
 
 /// A moving volume's pose table and the shell of bricks bounding its
 /// density over every pose.
-pub type Pose = (Arc<cirrus_render::transform_motion::PoseTable>, BrickVolume);
+pub type Pose = (Arc<cirrus_kernel::transform_motion::PoseTable>, BrickVolume);
 
 /// One volume's plan: where its grids are and how it is placed.
 pub struct Plan {

@@ -6,8 +6,8 @@
 use std::time::Instant;
 
 use cirrus_bricks::{Bounds3, DBounds3};
-use cirrus_render::medium::BrickField;
-use cirrus_render::transform_motion::MovingField;
+use cirrus_kernel::medium::BrickField;
+use cirrus_kernel::transform_motion::MovingField;
 use cirrus_render::{Camera, Crop, DensityField, RenderSettings, Rendered, Volumes};
 use glam::DVec3;
 

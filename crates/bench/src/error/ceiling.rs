@@ -18,7 +18,7 @@
 //! each budget.
 
 use super::Row;
-use cirrus_render::medium::Media;
+use cirrus_kernel::medium::Media;
 use std::fmt::Write as _;
 
 /// Nanoseconds of one render thread per tentative collision, over three
@@ -48,10 +48,10 @@ pub(super) struct CollisionCost {
 /// one-thread timing would run faster than the render threads and make
 /// the ceiling look lower than it is.
 pub(super) fn collision_cost<M: Media>(media: &M) -> CollisionCost {
-    use cirrus_render::medium::GlobalMedia;
-    use cirrus_render::stats::Counters;
-    use cirrus_render::tracking::{ratio_tracking, sample_free_flight};
-    use cirrus_render::{Ray, Rng};
+    use cirrus_kernel::medium::GlobalMedia;
+    use cirrus_kernel::tracking::{ratio_tracking, sample_free_flight};
+    use cirrus_kernel::{Ray, Rng};
+    use cirrus_render::Counters;
     use rayon::prelude::*;
     const RAYS_PER_THREAD: u64 = 50_000;
     let global = GlobalMedia::new(media);
@@ -72,7 +72,7 @@ pub(super) fn collision_cost<M: Media>(media: &M) -> CollisionCost {
                     let mut rng = Rng::new(0xC0_111DE, k, 0);
                     let u = glam::Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
                     let origin = lo + (hi - lo) * u;
-                    let dir = cirrus_render::sampling::uniform_sphere(rng.uniform(), rng.uniform());
+                    let dir = cirrus_kernel::sampling::uniform_sphere(rng.uniform(), rng.uniform());
                     let ray = Ray::new(origin, dir);
                     let mut beta = glam::Vec3::ONE;
                     std::hint::black_box(sample_free_flight::<f32, _>(

@@ -11,7 +11,8 @@
 
 use std::path::Path;
 
-use crate::error::{exr_error, Error, Result};
+use crate::exr_read::exr_error;
+use cirrus_kernel::{Error, Result};
 
 use glam::Vec3;
 

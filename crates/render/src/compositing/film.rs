@@ -6,7 +6,7 @@ use smallvec::SmallVec;
 
 use super::deep::{DeepPixel, DeepSample};
 use super::Compositing;
-use crate::integrator::Sample;
+use cirrus_kernel::integrator::Sample;
 
 /// What one tile keeps for the layers its render asked for; every vector
 /// is empty when its layer is off.

@@ -29,21 +29,9 @@ pub use depth_image::{DepthHoldout, DEFAULT_FAR};
 pub use film::Layers;
 pub(crate) use film::TileLayers;
 
+pub use cirrus_kernel::light::{GroupRadiance, DEFAULT_LIGHT_GROUPS, MAX_LIGHT_GROUPS};
+
 use std::sync::Arc;
-
-use glam::Vec3;
-
-/// The most light groups a render keeps (each costs 24 bytes a pixel of
-/// film and 12 a sample).
-pub const MAX_LIGHT_GROUPS: usize = 8;
-
-/// Radiance per light group, indexed by the group's position in
-/// [`Compositing::light_groups`].
-pub type GroupRadiance = [Vec3; MAX_LIGHT_GROUPS];
-
-/// Layer names of the default light groups: distant lights, domes and
-/// the media's emission ([`crate::Lights::new`] tags them so).
-pub const DEFAULT_LIGHT_GROUPS: [&str; 3] = ["sun", "sky", "emission"];
 
 /// Deep samples per pixel when none is given (the background sample
 /// comes on top).
@@ -70,8 +58,8 @@ impl Compositing {
 
     /// Checks the group names: at most [`MAX_LIGHT_GROUPS`], each a
     /// non-empty layer name (no `.`), no two alike.
-    pub fn validate(&self) -> crate::error::Result<()> {
-        use crate::error::Error;
+    pub fn validate(&self) -> cirrus_kernel::Result<()> {
+        use cirrus_kernel::Error;
         if self.light_groups.len() > MAX_LIGHT_GROUPS {
             return Err(Error::invalid(format!(
                 "{} light groups; at most {MAX_LIGHT_GROUPS} are kept",

@@ -8,30 +8,14 @@ use cirrus_render::{
 };
 use glam::Vec3;
 
-/// A 16^3 cloud-like blob over roughly [0, 1]^3: a smooth falloff times a
-/// lumpy modulation, zero near the array's faces, so the field has empty
-/// cells, interior cells and structure for the majorant grid to bound.
+/// The kernel's test cloud ([`GridField::cloud`]).
 pub fn cloud_field(cell_voxels: usize) -> GridField {
-    cloud_field_at(cell_voxels, Vec3::ZERO)
+    GridField::cloud(cell_voxels, Vec3::ZERO)
 }
 
 /// [`cloud_field`] moved by `offset`.
 pub fn cloud_field_at(cell_voxels: usize, offset: Vec3) -> GridField {
-    let n = 16;
-    let vs = 1.0 / n as f32;
-    GridField::from_fn(
-        [n, n, n],
-        Vec3::splat(0.5 * vs) + offset,
-        vs,
-        cell_voxels,
-        |i, j, k| {
-            let p = (Vec3::new(i as f32, j as f32, k as f32) + 0.5) / n as f32 - 0.5;
-            let r2 = (p * Vec3::new(1.0, 1.4, 1.0)).length_squared() / 0.2;
-            let lumps =
-                0.65 + 0.35 * (9.0 * p.x).sin() * (7.0 * p.y + 1.0).cos() * (8.0 * p.z).sin();
-            ((1.0 - r2).max(0.0) * lumps).max(0.0)
-        },
-    )
+    GridField::cloud(cell_voxels, offset)
 }
 
 pub fn medium<F: cirrus_render::DensityField>(

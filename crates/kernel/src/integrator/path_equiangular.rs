@@ -1,0 +1,284 @@
+//! Equi-angular sampling (Kulla and Fajardo 2012): a second strategy for
+//! the light a path segment scatters toward the camera from sphere, point
+//! and spot lights, beside the free flight's collision.
+//!
+//! Along a segment `o + t w`, the light of light `k` scattered once more is
+//! `integral T(0, t) sigma_s(t) N_k(t) dt`, `N_k` the next-event estimate
+//! at the point. Delta tracking estimates it at its collision (density
+//! `sigma_t T`), which in thin media falls anywhere but near a light, where
+//! `N_k` grows as `1 / d^2`: a beam in fog converges slowly and a point
+//! light inside a cloud has no finite variance. Equi-angular sampling
+//! draws `t` in the media's span of the segment with density
+//! `h / ((theta_b - theta_a) (h^2 + (t - delta)^2))` toward the light's
+//! centre, which cancels the `1 / d^2`, and estimates `T(0, t)` by the
+//! render's transmittance estimator (ratio tracking: unbiased in any
+//! heterogeneous medium, as in Kutz et al. 2017's decomposition of
+//! null-collision estimators) and `sigma_s` by a lookup.
+//!
+//! The two strategies' weights are any pair summing to one at each `t`
+//! (Veach 1997's multi-sample model); the collision density needs the
+//! transmittance, which only a second walk could give, so the weights take
+//! the power heuristic of the equi-angular density against a uniform
+//! density over the segment's span: equi-angular sampling where it is
+//! denser (about the light), the collision elsewhere. Both are exact for
+//! any weights; these only decide the noise.
+//!
+//! One light per segment takes the equi-angular sample, picked in
+//! proportion to its unoccluded single scattering along the span, `I (theta_b
+//! - theta_a) / h`.
+
+use glam::Vec3;
+
+use super::path::PathTracer;
+use super::path_state::{Arrival, Path, Vertex};
+use crate::counters::Counters;
+use crate::light::{Light, SphereLight};
+use crate::medium::Media;
+use crate::ray::Ray;
+use crate::sampling::{power_heuristic, SampleStream};
+use crate::spectrum::{luminance, Spectrum};
+use crate::tracking::transmittance;
+
+/// The light sample rank the equi-angular point's next-event estimate
+/// draws (past the stratified ranks a vertex's own samples use).
+const EQUIANGULAR_LIGHT_SAMPLE: u32 = 2;
+
+/// Equi-angular sampling of distance along a ray toward a point, over a
+/// span of the ray.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct EquiAngular {
+    /// Distance along the ray to the point's foot.
+    delta: f32,
+    /// The point's distance from the ray.
+    h: f32,
+    theta_a: f32,
+    theta_b: f32,
+}
+
+impl EquiAngular {
+    /// Toward `c` along `ray` over `[t0, t1]`; `None` for an empty span or
+    /// a ray through `c` (its density would be a delta).
+    #[inline]
+    pub fn new(ray: &Ray, c: Vec3, t0: f32, t1: f32) -> Option<Self> {
+        let to_c = c - ray.origin;
+        let delta = to_c.dot(ray.dir);
+        let h = (to_c - delta * ray.dir).length();
+        let scale = to_c.length().max(t1 - t0);
+        // Written so that NaN fails too.
+        let usable = t1 > t0 && h > 1e-5 * scale && h.is_finite();
+        if !usable {
+            return None;
+        }
+        let theta_a = ((t0 - delta) / h).atan();
+        let theta_b = ((t1 - delta) / h).atan();
+        (theta_b > theta_a).then_some(Self {
+            delta,
+            h,
+            theta_a,
+            theta_b,
+        })
+    }
+
+    /// A distance drawn with `u`, and its density.
+    #[inline]
+    pub fn sample(&self, u: f32) -> (f32, f32) {
+        let theta = self.theta_a + u * (self.theta_b - self.theta_a);
+        let t = self.delta + self.h * theta.tan();
+        (t, self.pdf(t))
+    }
+
+    /// The density of drawing `t`.
+    #[inline]
+    pub fn pdf(&self, t: f32) -> f32 {
+        let x = t - self.delta;
+        self.h / ((self.theta_b - self.theta_a) * (self.h * self.h + x * x))
+    }
+
+    /// `integral dt / d^2` over the span: the unoccluded single scattering
+    /// of a unit point light, up to its phase and medium.
+    #[inline]
+    fn reach(&self) -> f32 {
+        (self.theta_b - self.theta_a) / self.h
+    }
+}
+
+/// The equi-angular strategy's weight at `t`, drawn with density `pdf`,
+/// on a span of length `len`: the power heuristic against a uniform density
+/// over the span (see the module documentation).
+#[inline]
+fn weight(pdf: f32, len: f32) -> f32 {
+    power_heuristic(pdf, 1.0 / len)
+}
+
+/// A segment's span in the media, `[t0, t1]`, within `t_max`.
+#[inline]
+fn span<M: Media>(medium: &M, ray: &Ray) -> Option<(f32, f32)> {
+    let (t0, t1) = medium
+        .bounds()
+        .clip_ray(ray.origin, ray.dir, 0.0, ray.t_max)?;
+    (t1 > t0 && t1.is_finite()).then_some((t0, t1))
+}
+
+impl<M: Media> PathTracer<'_, M> {
+    /// Whether a segment flown at `path.depth` takes an equi-angular sample:
+    /// where a collision on it would estimate the lights (not past the
+    /// last scattering event, not when only emission is gathered).
+    #[inline]
+    pub(super) fn equiangular_runs(&self, path: &Path) -> bool {
+        self.equiangular && !path.emission_only && self.max_depth.is_none_or(|m| path.depth < m)
+    }
+
+    /// The weight of the next-event estimate of sphere light `light` at
+    /// vertex `v` against the equi-angular sample of the segment that
+    /// reached it: one minus the equi-angular strategy's weight there.
+    #[inline]
+    pub(super) fn collision_weight(&self, v: &Vertex, light: &SphereLight) -> f32 {
+        if !self.equiangular {
+            return 1.0;
+        }
+        let ray = v.ray_in;
+        let Some((t0, t1)) = span(self.medium, ray) else {
+            return 1.0;
+        };
+        let Some(ea) = EquiAngular::new(ray, light.position(), t0, t1) else {
+            return 1.0;
+        };
+        let t = (v.p - ray.origin).dot(ray.dir);
+        1.0 - weight(ea.pdf(t), t1 - t0)
+    }
+
+    /// The equi-angular sample of the path's current segment: one sphere
+    /// light picked by its reach, a point drawn toward it, and the light
+    /// scattered there toward the path, weighed against the collision.
+    pub(super) fn equiangular<S: Spectrum>(
+        &self,
+        path: &mut Path,
+        draws: &mut SampleStream,
+        c: &mut Counters,
+    ) {
+        let ray = path.ray;
+        let Some((t0, t1)) = span(self.medium, &ray) else {
+            return;
+        };
+        // One sphere light picked in proportion to its reach (two passes:
+        // the sum, then the pick, recomputing each light's sampler).
+        let reach = |s: &SphereLight| {
+            let ea = EquiAngular::new(&ray, s.position(), t0, t1)?;
+            let w = luminance(s.intensity()) * ea.reach();
+            (w > 0.0 && w.is_finite()).then_some((ea, w))
+        };
+        let total: f32 = self
+            .spheres
+            .iter()
+            .filter_map(|(_, s)| reach(s))
+            .map(|r| r.1)
+            .sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return;
+        }
+        let u = draws.rng().uniform() * total;
+        let mut end = 0.0;
+        let mut chosen = None;
+        for (i, s) in &self.spheres {
+            if let Some((ea, w)) = reach(s) {
+                end += w;
+                chosen = Some((*i, ea, w));
+                if u < end {
+                    break;
+                }
+            }
+        }
+        let Some((light, ea, w)) = chosen else {
+            return;
+        };
+        let q = w / total;
+        let (t, pdf) = ea.sample(draws.rng().uniform());
+        if !(t > t0 && t < t1 && pdf > 0.0) {
+            return;
+        }
+        c.equiangular_samples += 1;
+        let tr: S = transmittance(self.estimator, self.medium, &ray, t, draws.rng(), c);
+        if !tr.any_positive() {
+            return;
+        }
+        let p = ray.at(t);
+        let sigma_t: S = self.medium.extinction(p, ray.time);
+        let it = self.medium.interaction(p, ray.time, draws.rng());
+        if path.depth == 0 && it.holdout {
+            return;
+        }
+        let depth = path.depth + 1;
+        let v = Vertex {
+            p,
+            ray_in: &ray,
+            phase: it.phase,
+            mis: self.max_depth != Some(depth),
+            index: u32::MAX,
+            choice: super::light_choice::LightChoice::All,
+            arrival: Arrival::default(),
+        };
+        let Light::Sphere(sphere) = self.lights.get(light) else {
+            return;
+        };
+        let n = self.sphere_sample::<S>(&v, sphere, 1.0, EQUIANGULAR_LIGHT_SAMPLE, draws, c);
+        let scale = weight(pdf, t1 - t0) / (q * pdf);
+        let e = path.beta * tr.rgb() * sigma_t.rgb() * it.albedo * it.weight * n * scale;
+        path.add_to_group(e, self.lights.group(light), self.light_groups);
+        if path.depth == 0 {
+            path.out.aov.direct += e;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_density_integrates_to_one_and_sampling_follows_it() {
+        let ray = Ray::new(Vec3::new(0.0, 0.0, -3.0), Vec3::Z);
+        let ea = EquiAngular::new(&ray, Vec3::new(0.5, 0.2, 1.0), 0.5, 9.0).unwrap();
+        let n = 100_000;
+        let h = (9.0 - 0.5) / n as f32;
+        let integral: f32 = (0..n).map(|i| ea.pdf(0.5 + (i as f32 + 0.5) * h) * h).sum();
+        assert!((integral - 1.0).abs() < 1e-3, "{integral}");
+        // The fraction of draws below t is the density's integral to t.
+        let below = |t: f32| {
+            (0..n)
+                .filter(|&i| ea.sample((i as f32 + 0.5) / n as f32).0 < t)
+                .count() as f32
+                / n as f32
+        };
+        for t in [2.0, 4.0, 4.2, 6.0] {
+            let m = ((t - 0.5) / h) as usize;
+            let cdf: f32 = (0..m).map(|i| ea.pdf(0.5 + (i as f32 + 0.5) * h) * h).sum();
+            assert!(
+                (below(t) - cdf).abs() < 2e-3,
+                "at {t}: {} vs {cdf}",
+                below(t)
+            );
+        }
+        let (t, pdf) = ea.sample(0.3);
+        assert_eq!(pdf, ea.pdf(t));
+        assert!(
+            EquiAngular::new(&ray, Vec3::new(0.0, 0.0, 2.0), 0.5, 9.0).is_none(),
+            "on the ray"
+        );
+    }
+
+    #[test]
+    fn the_weights_of_both_strategies_sum_to_one() {
+        let ray = Ray::new(Vec3::ZERO, Vec3::X);
+        let ea = EquiAngular::new(&ray, Vec3::new(3.0, 0.5, 0.0), 0.0, 20.0).unwrap();
+        for t in [0.1, 2.9, 3.0, 7.0, 19.0] {
+            let w = weight(ea.pdf(t), 20.0);
+            assert!((0.0..=1.0).contains(&w));
+            if t == 3.0 {
+                assert!(w > 0.99, "about the light: {w}");
+            }
+            if t == 19.0 {
+                assert!(w < 0.5, "far from it: {w}");
+            }
+        }
+    }
+}
