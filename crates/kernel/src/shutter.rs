@@ -27,6 +27,11 @@ impl Shutter {
         Self { open, close }
     }
 
+    /// The open and close times, as scene files spell them.
+    pub const fn times(self) -> [f32; 2] {
+        [self.open, self.close]
+    }
+
     /// Checks the interval is finite and not reversed.
     pub fn validate(&self) -> Result<()> {
         if !(self.open.is_finite() && self.close.is_finite()) || self.close < self.open {

@@ -40,6 +40,9 @@ pub struct Adaptive {
 }
 
 impl Adaptive {
+    /// Samples every pixel takes before it may stop, when none is given.
+    pub const DEFAULT_MIN_SPP: u32 = 16;
+
     pub fn validate(&self) -> Result<()> {
         if !(self.threshold.is_finite() && self.threshold > 0.0) {
             return Err(Error::invalid(format!(

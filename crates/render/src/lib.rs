@@ -43,7 +43,9 @@ pub use control::RenderControl;
 pub use exr_read::read_env_map;
 pub use film::{AovImage, Halves, Image};
 pub use render::{render, Denoised, Rendered, Window};
-pub use scene::{Budget, Crop, RenderSettings, Scene, DEFAULT_SPP, DEFAULT_STEP_VOXELS};
+pub use scene::{
+    Budget, Crop, RenderSettings, Scene, DEFAULT_SEED, DEFAULT_SPP, DEFAULT_STEP_VOXELS,
+};
 pub use stats::RenderStats;
 
 pub use cirrus_kernel::{

@@ -39,13 +39,17 @@ pub enum Budget {
 /// Samples per pixel when no budget is given.
 pub const DEFAULT_SPP: u32 = 64;
 
+/// The seed when none is given.
+pub const DEFAULT_SEED: u64 = 0;
+
 /// The ray marchers' step in voxels when none is given.
 pub const DEFAULT_STEP_VOXELS: f32 = 0.5;
 
 /// Everything about how to render, independent of the scene.
 ///
 /// Its [`Default`] is the renderer's one set of defaults: each settings
-/// enum's own `Default`, [`DEFAULT_SPP`] and [`DEFAULT_STEP_VOXELS`]; the
+/// enum's own `Default`, [`DEFAULT_SPP`], [`DEFAULT_SEED`],
+/// [`DEFAULT_STEP_VOXELS`] and [`Shutter::INSTANT`]; the
 /// scene files and the command line declare theirs from these.
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
@@ -130,7 +134,7 @@ impl Default for RenderSettings {
             transmittance: TransmittanceEstimator::default(),
             majorant: MajorantMode::default(),
             budget: Budget::Spp(DEFAULT_SPP),
-            seed: 0,
+            seed: DEFAULT_SEED,
             sampler: SamplerKind::default(),
             adaptive: None,
             max_depth: None,

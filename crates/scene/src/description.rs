@@ -73,7 +73,7 @@ declare_settings! {
     /// Render passes until this many seconds are spent (instead of spp).
     time: f64, flag(long), unset("off"), example(0.5);
     /// Same seed, same image, on any thread count.
-    seed: u64, flag(long), default(0), example(7);
+    seed: u64, flag(long), default(cirrus_render::DEFAULT_SEED), example(7);
     /// Sample numbers: Owen-scrambled Sobol points for the first path
     /// vertices, or independent random numbers.
     sampler: SamplerKind, flag(long, value_enum), default(SamplerKind::default()),
@@ -83,7 +83,7 @@ declare_settings! {
     /// pixels of highest error.
     noise_threshold: f32, flag(long), unset("off"), example(0.05);
     /// Samples every pixel takes before adaptive sampling may stop it.
-    min_spp: u32, flag(long), default(16), example(4);
+    min_spp: u32, flag(long), default(cirrus_render::Adaptive::DEFAULT_MIN_SPP), example(4);
     /// The integrator: unbiased path tracing, or ray marching (single
     /// scattering; two-pass over a cached light grid).
     integrator: IntegratorKind, flag(long, value_enum), default(IntegratorKind::default()),
@@ -141,7 +141,7 @@ declare_settings! {
     /// Motion blur: the shutter's open and close times in frames around
     /// the frame, e.g. -0.25,0.25 (centred) or 0,0.5.
     shutter: [f32; 2], flag(long, value_parser = parse::shutter, allow_hyphen_values = true),
-        default([0.0, 0.0]), example([-0.25, 0.25]);
+        default(cirrus_render::Shutter::INSTANT.times()), example([-0.25, 0.25]);
     /// Frames A-B[:STEP]: the frame number replaces `####` or `%04d` in
     /// every input and output path.
     frames: String, flag(long), unset("one frame, no pattern"), example("1-2".into());

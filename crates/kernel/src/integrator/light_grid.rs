@@ -239,20 +239,13 @@ impl LightGrid {
         entry: &mut [Vec4],
     ) {
         let p = self.lo + self.cell * Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32);
+        let shadow = |dir: Vec3, distance: f32, rng: &mut Rng, c: &mut Counters| {
+            let end = ShadowEnd::Cutoff;
+            marched_transmittance::<M, f32>(medium, p, dir, distance, step, end, rng, c)
+        };
         for (slot, light) in entry.iter_mut().zip(lights.iter()) {
             match light {
-                Light::Distant(sun) => {
-                    slot.x = marched_transmittance::<M, f32>(
-                        medium,
-                        p,
-                        -sun.direction(),
-                        f32::INFINITY,
-                        step,
-                        ShadowEnd::Cutoff,
-                        rng,
-                        c,
-                    );
-                }
+                Light::Distant(sun) => slot.x = shadow(-sun.direction(), f32::INFINITY, rng, c),
                 Light::Dome(_) => {
                     // Directions stratified in cos(theta), random in phi.
                     let (mut a, mut b) = (0.0, Vec3::ZERO);
@@ -261,16 +254,7 @@ impl LightGrid {
                         let r = (1.0 - z * z).max(0.0).sqrt();
                         let phi = std::f32::consts::TAU * rng.uniform();
                         let w = from_local(Vec3::Z, r * phi.cos(), r * phi.sin(), z);
-                        let tr = marched_transmittance::<M, f32>(
-                            medium,
-                            p,
-                            w,
-                            f32::INFINITY,
-                            step,
-                            ShadowEnd::Cutoff,
-                            rng,
-                            c,
-                        );
+                        let tr = shadow(w, f32::INFINITY, rng, c);
                         a += tr;
                         b += tr * w;
                     }
@@ -282,31 +266,13 @@ impl LightGrid {
                     // Toward the centre.
                     let to = light.centre() - p;
                     let d = to.length();
-                    slot.x = marched_transmittance::<M, f32>(
-                        medium,
-                        p,
-                        to / d,
-                        d,
-                        step,
-                        ShadowEnd::Cutoff,
-                        rng,
-                        c,
-                    );
+                    slot.x = shadow(to / d, d, rng, c);
                 }
                 Light::Sphere(light) => {
                     // Toward the centre, to the ball's surface.
                     let to = light.position() - p;
                     let d = to.length();
-                    slot.x = marched_transmittance::<M, f32>(
-                        medium,
-                        p,
-                        to / d,
-                        (d - light.radius()).max(0.0),
-                        step,
-                        ShadowEnd::Cutoff,
-                        rng,
-                        c,
-                    );
+                    slot.x = shadow(to / d, (d - light.radius()).max(0.0), rng, c);
                 }
             }
         }
