@@ -2,18 +2,20 @@
 //! radiance emitting from one side (UsdLux's `RectLight` and `DiskLight`,
 //! Blender's area lamps), along their normal.
 //!
-//! Next-event estimation samples a point uniformly on the shape (the
-//! disc by Shirley and Chiu's concentric map), so the solid-angle density
-//! toward it is `d^2 / (A cos theta_l)` (pbrt-v4's shapes sampled by area);
-//! a ray that meets the shape's front gathers its radiance, weighed by the
-//! same density. Spherical-rectangle sampling (Urena et al. 2013), better
-//! close to a large light, is not used: MIS with phase sampling covers
-//! the near field.
+//! Next-event estimation samples a rectangle uniformly in the solid angle
+//! it subtends (`spherical_rect.rs`, Urena et al. 2013: density `1 / S`,
+//! bounded however close the vertex), and a disc, or a rectangle too
+//! small to matter, by a point uniform on the shape (the disc by Shirley
+//! and Chiu's concentric map), the solid-angle density toward it
+//! `d^2 / (A cos theta_l)` (pbrt-v4's shapes sampled by area). A ray that
+//! meets the shape's front gathers its radiance, weighed by the density
+//! the vertex it left would have sampled it with.
 
 use std::f32::consts::{FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
+use super::spherical_rect::SphericalRect;
 use super::LightSample;
 
 /// The outline of an area light.
@@ -114,15 +116,31 @@ impl AreaLight {
         self.centre + a * self.half_u + b * self.half_v
     }
 
-    /// Samples the light from `p`: a point uniform on the shape, with the
-    /// solid-angle density toward it; a zero-density sample from behind.
+    /// The rectangle as seen from `p` in front of it, where it subtends
+    /// enough to be sampled by solid angle.
+    #[inline]
+    fn spherical_from(&self, p: Vec3) -> Option<SphericalRect> {
+        let in_front = (p - self.centre).dot(self.normal) > 0.0;
+        (self.shape == AreaShape::Rect && in_front).then(|| {
+            let corner = self.centre - self.half_u - self.half_v;
+            SphericalRect::seen_from(corner, 2.0 * self.half_u, 2.0 * self.half_v, p)
+        })?
+    }
+
+    /// Samples the light from `p`: a direction uniform in a rectangle's
+    /// solid angle, or a point uniform on the shape, with the solid-angle
+    /// density toward it; a zero-density sample from behind.
     #[inline]
     pub fn sample(&self, p: Vec3, u1: f32, u2: f32) -> LightSample {
-        let (a, b) = match self.shape {
-            AreaShape::Rect => (2.0 * u1 - 1.0, 2.0 * u2 - 1.0),
-            AreaShape::Disk => concentric_disk(u1, u2).into(),
+        let spherical = self.spherical_from(p);
+        let q = match (spherical, self.shape) {
+            (Some(rect), _) => rect.sample(u1, u2),
+            (None, AreaShape::Rect) => self.at(2.0 * u1 - 1.0, 2.0 * u2 - 1.0),
+            (None, AreaShape::Disk) => {
+                let ab = concentric_disk(u1, u2);
+                self.at(ab.x, ab.y)
+            }
         };
-        let q = self.at(a, b);
         let to = q - p;
         let d2 = to.length_squared();
         let d = d2.sqrt();
@@ -136,10 +154,14 @@ impl AreaLight {
                 distance: 0.0,
             };
         }
+        let pdf = match spherical {
+            Some(rect) => (1.0 / rect.solid_angle()) as f32,
+            None => d2 / (self.area * cos_l),
+        };
         LightSample {
             to_light,
             radiance: self.radiance,
-            pdf: Some(d2 / (self.area * cos_l)),
+            pdf: Some(pdf),
             distance: d,
         }
     }
@@ -164,7 +186,13 @@ impl AreaLight {
             AreaShape::Rect => a.abs() <= 1.0 && b.abs() <= 1.0,
             AreaShape::Disk => a * a + b * b <= 1.0,
         };
-        inside.then(|| (t, self.radiance, t * t / (self.area * cos_l)))
+        inside.then(|| {
+            let pdf = match self.spherical_from(p) {
+                Some(rect) => (1.0 / rect.solid_angle()) as f32,
+                None => t * t / (self.area * cos_l),
+            };
+            (t, self.radiance, pdf)
+        })
     }
 
     /// The luminance of what the light sends toward `p` unoccluded, as an

@@ -13,6 +13,7 @@ mod area;
 mod distant;
 mod dome;
 mod sphere;
+mod spherical_rect;
 
 pub use area::{AreaLight, AreaShape};
 pub use distant::Sun;
