@@ -236,15 +236,11 @@ def test_point_and_spot_lamps_render_as_cycles_does(addon, tmp_path):
     assert not any("lamps are not rendered" in m for m in warnings), warnings
 
 
-def test_area_lamps_render_as_cycles_does(addon, tmp_path):
-    """A rectangle beside the cloud facing it and an ellipse above it
-    facing down, the sun and sky off."""
+def add_area_lamps(scene) -> None:
+    """A rectangle beside the cloud facing it (its light along local -Z,
+    turned to -X) and an ellipse above it facing down."""
     import mathutils
 
-    scene, _ = build_scene()
-    add_lamps(scene)
-    for name in ("Bulb", "Beam"):
-        scene.objects[name].hide_render = True
     obj = scene.objects["Cloud"]
     corners = [obj.matrix_world @ mathutils.Vector(c) for c in obj.bound_box]
     lo = [min(c[i] for c in corners) for i in range(3)]
@@ -252,7 +248,7 @@ def test_area_lamps_render_as_cycles_does(addon, tmp_path):
     centre = mathutils.Vector([(a + b) / 2 for a, b in zip(lo, hi)])
     size = max(b - a for a, b in zip(lo, hi))
     for name, shape, offset, rotation in (
-        ("Panel", "RECTANGLE", (0.7, -0.2, 0.0), (0.0, math.radians(-90.0), 0.0)),
+        ("Panel", "RECTANGLE", (0.7, -0.2, 0.0), (0.0, math.radians(90.0), 0.0)),
         ("Ceiling", "ELLIPSE", (0.0, 0.0, 0.7), (0.0, 0.0, math.radians(30.0))),
     ):
         data = bpy.data.lights.new(name, "AREA")
@@ -263,8 +259,32 @@ def test_area_lamps_render_as_cycles_does(addon, tmp_path):
         lamp.location = centre + size * mathutils.Vector(offset)
         lamp.rotation_euler = rotation
         lamp.visible_camera = False  # cirrus's lamps light, camera rays miss them
-        lamp.visible_camera = False  # cirrus's lamps light, camera rays miss them
-    scene.collection.objects.link(lamp)
+        scene.collection.objects.link(lamp)
+
+
+def test_area_lamps_render_as_cycles_does(addon, tmp_path):
+    """The area lamps alone, the sun and sky off."""
+    scene, _ = build_scene()
+    add_lamps(scene)
+    for name in ("Bulb", "Beam"):
+        scene.objects[name].hide_render = True
+    add_area_lamps(scene)
+    assert_renders_as_cycles(addon, scene, tmp_path)
+    warnings = [m for _, m in addon.engine.REPORTS]
+    assert not any("lamps are not rendered" in m for m in warnings), warnings
+
+
+def test_every_lamp_kind_together_renders_as_cycles_does(addon, tmp_path):
+    """The sun, the sky, a point, a spot, a rectangle and an ellipse
+    lighting the cloud at once."""
+    scene, _ = build_scene()
+    background = scene.world.node_tree.nodes["Background"].inputs["Strength"]
+    sky = background.default_value
+    add_lamps(scene)
+    add_area_lamps(scene)
+    scene.objects["Sun"].hide_render = False
+    background.default_value = sky
+    assert sky > 0.0
     assert_renders_as_cycles(addon, scene, tmp_path)
     warnings = [m for _, m in addon.engine.REPORTS]
     assert not any("lamps are not rendered" in m for m in warnings), warnings
