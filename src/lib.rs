@@ -3,8 +3,10 @@
 //! The workspace is a pipeline of small crates, re-exported here:
 //! [`vdb`] reads `.vdb` and `.nvdb` files into a sparse tree, [`bricks`]
 //! converts a density tree into 8^3 bricks with a majorant/minorant
-//! hierarchy and walks rays through it, [`render`] (camera, lights,
-//! trackers, integrators, film) turns that into images, and [`scene`]
+//! hierarchy and walks rays through it, [`kernel`] (camera, lights,
+//! media, trackers, integrators) traces light paths through it,
+//! [`render`] runs them over tiles into a film and writes images, and
+//! [`scene`]
 //! reads scene files, applies overrides and defaults, loads only what can
 //! be seen and renders it. The `cirrus` binary (`crates/cli`) is a thin
 //! command line over them; the Python module (`crates/python`) another.
@@ -27,6 +29,7 @@
 //! (`benches/`) that span the crates.
 
 pub use cirrus_bricks as bricks;
+pub use cirrus_kernel as kernel;
 pub use cirrus_render as render;
 pub use cirrus_scene as scene;
 pub use cirrus_vdb as vdb;

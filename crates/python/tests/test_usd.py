@@ -288,8 +288,8 @@ def down_matrix(at) -> Gf.Matrix4d:
 def author_lights(d: Path) -> Path:
     """The cloud lit by every light kind the reader takes: a sun, a moon (a
     second distant light), a sphere light moved and scaled, a point spot
-    shaped by UsdLux's ShapingAPI turned to point down, and a rect light
-    facing down."""
+    shaped by UsdLux's ShapingAPI turned to point down, a rect light
+    facing down and a cylinder light turned off the X axis."""
     from pxr import UsdLux
 
     d.mkdir(parents=True, exist_ok=True)
@@ -327,6 +327,12 @@ def author_lights(d: Path) -> Path:
     panel.CreateIntensityAttr(2.5)
     panel.CreateNormalizeAttr(True)
     panel.AddTransformOp().Set(down_matrix((170.0, 190.0, 90.0)))
+    tube = UsdLux.CylinderLight.Define(stage, "/Lights/Tube")
+    tube.CreateLengthAttr(30.0)
+    tube.CreateRadiusAttr(2.0)
+    tube.CreateIntensityAttr(3.0)
+    UsdGeom.XformCommonAPI(tube.GetPrim()).SetTranslate(Gf.Vec3d(120.0, 150.0, 40.0))
+    UsdGeom.XformCommonAPI(tube.GetPrim()).SetRotate(Gf.Vec3f(0.0, 0.0, 30.0))
     us.camera(stage)
     us.render_settings(stage, res=(RES, RES))
     stage.GetRootLayer().Save()
@@ -343,6 +349,7 @@ def lights_twin(d: Path) -> dict:
     bulb = world("/Lights/Bulb")
     lamp = world("/Lights/Lamp")
     panel = world("/Lights/Panel")
+    tube = world("/Lights/Tube")
     axis = lamp.TransformDir(Gf.Vec3d(0, 0, -1))
     scale = sum(bulb.TransformDir(Gf.Vec3d(*e)).GetLength() for e in ((1, 0, 0), (0, 1, 0), (0, 0, 1))) / 3
     return {
@@ -380,6 +387,16 @@ def lights_twin(d: Path) -> dict:
                 "height": 25.0,
                 "color": [2.5] * 3,
                 "normalize": True,
+            },
+            {
+                "type": "cylinder",
+                "name": "Tube",
+                "position": list(tube.Transform(Gf.Vec3d(0, 0, 0))),
+                "direction": list(tube.TransformDir(Gf.Vec3d(1, 0, 0))),
+                "length": 30.0,
+                "radius": 2.0,
+                "color": [3.0] * 3,
+                "normalize": False,
             },
         ],
         "volume": [

@@ -463,6 +463,20 @@ fn a_small_area_light_lights_as_a_point_of_lambertian_intensity() {
 }
 
 #[test]
+fn a_small_cylinder_lights_as_a_line_of_intensity_by_its_projected_side() {
+    // Intensity `L 2 r l sin(theta)` off its axis (its side projected;
+    // the caps are dark), `A / pi` at its widest; its length 0.06 against
+    // distances of at least 1.4.
+    let axis = Vec3::new(0.3, 1.0, -0.4).normalize();
+    let light = AreaLight::cylinder(Vec3::ZERO, axis, 0.06, 0.01, INTENSITY);
+    let intensity = INTENSITY * light.area() / std::f32::consts::PI;
+    let out = render_fog(Lights::new([light.into()]), Some(1), 64, 47);
+    assert!(out.stats.counters.nee_rays_area > 0);
+    let expected = airlight_image(intensity, Vec3::ZERO, &|w| w.cross(axis).length() as f64);
+    assert_matches("small cylinder", &out, &every(expected));
+}
+
+#[test]
 fn a_rect_light_seen_through_fog_shows_its_radiance_times_the_transmittance() {
     let centre = Vec3::new(0.0, 0.0, 3.0);
     let rect = AreaLight::new(

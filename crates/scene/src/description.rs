@@ -250,29 +250,33 @@ declare_settings! {
     @file_only {
         /// `distant`, `sphere`, `point` (a sphere of radius 0), `spot` (a
         /// sphere or point in a cone), `rect`, `disk` (one-sided area
-        /// lights) or `dome`.
+        /// lights), `cylinder` (a cylinder's side, emitting outward) or
+        /// `dome`.
         kind as "type": String;
         /// The light's name: its light-group layer where no `group` is
         /// given (unnamed lights join `sun`, `sky` or `lights` by kind).
         name: Option<String>;
         /// The light-group layer its light goes to.
         group: Option<String>;
-        /// Where a sphere, point or spot light is.
+        /// Where a sphere, point, spot or area light is (an area light's
+        /// centre).
         position: Option<[f32; 3]>;
-        /// Direction a distant light's light travels, a spot's axis, or
-        /// the side an area light emits toward.
+        /// Direction a distant light's light travels, a spot's axis, the
+        /// side an area light emits toward, or a cylinder's axis.
         direction: Option<[f32; 3]>;
         /// An area light's second axis (its height's), turned square to
         /// `direction` (default +Y, or +Z along Y).
         up: Option<[f32; 3]>;
         /// A sphere or spot light's radius (sphere default 0.5, UsdLux's),
-        /// or a disk's (default 0.5).
+        /// or a disk's or cylinder's (default 0.5).
         radius: Option<f32>;
         /// A rect's width (default 1), or a disk's diameter across, an
         /// ellipse where it differs from `height`.
         width: Option<f32>;
         /// A rect's height (default 1), or a disk's diameter along `up`.
         height: Option<f32>;
+        /// A cylinder's length along its axis (default 1, UsdLux's).
+        length: Option<f32>;
         /// Colour, multiplying `intensity` (default 1,1,1).
         color: Option<[f32; 3]>;
         /// The light's strength (default 1), times `2^exposure` and
@@ -284,8 +288,8 @@ declare_settings! {
         /// Stops (default 0): `intensity * 2^exposure`.
         exposure: Option<f32>;
         /// A sphere or area light's radiance divided by its area (`4 pi
-        /// r^2` for a sphere), so its power does not change with its size
-        /// (UsdLux `normalize`).
+        /// r^2` for a sphere, `2 pi r l` for a cylinder's side), so its
+        /// power does not change with its size (UsdLux `normalize`).
         normalize: Option<bool>;
         /// A distant light's angular diameter in degrees (default 0.53).
         angle: Option<f32>;

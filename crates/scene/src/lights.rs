@@ -6,8 +6,8 @@
 //! writes it: a distant light's irradiance (W/m^2 on a surface facing
 //! it, as `[sun]`), a sphere's surface radiance (divided by its area
 //! `4 pi r^2` where `normalize` is set), a point's radiant intensity
-//! (W/sr; a point has no surface), an area light's radiance (over its
-//! area where `normalize` is on), a dome's radiance or its map's
+//! (W/sr; a point has no surface), an area light's radiance (a rect's,
+//! a disk's or a cylinder's side; over its area where `normalize` is on), a dome's radiance or its map's
 //! multiplier. A sphere of radius `r` and radiance `L` lights the far
 //! field as a point of intensity `L pi r^2`.
 //!
@@ -31,13 +31,18 @@ use crate::error::{Error, Result};
 const DEFAULT_ANGLE_DEGREES: f32 = 0.53;
 /// A sphere light's radius where none is given (UsdLux's fallback).
 const DEFAULT_SPHERE_RADIUS: f32 = 0.5;
-/// A disk light's radius where none is given (UsdLux's fallback).
+/// A disk or cylinder light's radius where none is given (UsdLux's
+/// fallback).
 const DEFAULT_DISK_RADIUS: f32 = 0.5;
+/// A cylinder light's length where none is given (UsdLux's fallback).
+const DEFAULT_CYLINDER_LENGTH: f32 = 1.0;
 /// The layer of sphere and spot lights with no name or group.
 const DEFAULT_LOCAL_GROUP: &str = "lights";
 
 /// The kinds of `[[light]]`.
-const KINDS: [&str; 7] = ["distant", "sphere", "point", "spot", "rect", "disk", "dome"];
+const KINDS: [&str; 8] = [
+    "distant", "sphere", "point", "spot", "rect", "disk", "cylinder", "dome",
+];
 
 /// The keys each kind takes besides `type`, `name`, `group`, `color`,
 /// `intensity` and `exposure`.
@@ -71,6 +76,7 @@ fn keys_of(kind: &str) -> &'static [&'static str] {
             "height",
             "normalize",
         ],
+        "cylinder" => &["position", "direction", "radius", "length", "normalize"],
         _ => &["map", "rotation"],
     }
 }
@@ -93,6 +99,7 @@ impl LightSpec {
             ("up", self.up.is_some()),
             ("width", self.width.is_some()),
             ("height", self.height.is_some()),
+            ("length", self.length.is_some()),
             ("radius", self.radius.is_some()),
             ("normalize", self.normalize.is_some()),
             ("angle", self.angle.is_some()),
@@ -110,13 +117,8 @@ impl LightSpec {
     pub fn check(&self) -> std::result::Result<(), String> {
         let kind = self.kind.as_str();
         if !KINDS.contains(&kind) {
-            let hint = if kind == "cylinder" {
-                " (cylinder lights are not rendered yet)"
-            } else {
-                ""
-            };
             return Err(format!(
-                "unknown type {kind:?}{hint}; one of {}",
+                "unknown type {kind:?}; one of {}",
                 KINDS.join(", ")
             ));
         }
@@ -148,7 +150,11 @@ impl LightSpec {
         if let Some(r) = self.radius {
             at_least_zero("radius", &[r])?;
         }
-        for (key, size) in [("width", self.width), ("height", self.height)] {
+        for (key, size) in [
+            ("width", self.width),
+            ("height", self.height),
+            ("length", self.length),
+        ] {
             if let Some(x) = size {
                 finite(key, &[x])?;
                 if x <= 0.0 {
@@ -161,7 +167,7 @@ impl LightSpec {
         if let Some(u) = self.up {
             finite("up", &u)?;
         }
-        if kind == "disk" && self.radius == Some(0.0) {
+        if matches!(kind, "disk" | "cylinder") && self.radius == Some(0.0) {
             return Err("`radius` 0: an area light needs an area".into());
         }
         if kind == "disk"
@@ -189,10 +195,10 @@ impl LightSpec {
             "sphere" | "point" | "spot" if self.position.is_none() => {
                 Err(format!("a {kind} light needs `position`"))
             }
-            "spot" | "rect" | "disk" if self.direction.is_none() => {
+            "spot" | "rect" | "disk" | "cylinder" if self.direction.is_none() => {
                 Err(format!("a {kind} light needs `direction`"))
             }
-            "rect" | "disk" if self.position.is_none() => {
+            "rect" | "disk" | "cylinder" if self.position.is_none() => {
                 Err(format!("a {kind} light needs `position`"))
             }
             "spot" => {
@@ -242,7 +248,7 @@ impl LightSpec {
                 self.angle.unwrap_or(DEFAULT_ANGLE_DEGREES).to_radians(),
             )
             .into(),
-            "rect" | "disk" => self
+            "rect" | "disk" | "cylinder" => self
                 .area_light(strength)
                 .seen_by_camera(self.visible_to_camera.unwrap_or(false))
                 .into(),
@@ -277,10 +283,38 @@ impl LightSpec {
 }
 
 impl LightSpec {
-    /// A `rect` or `disk` light of strength `strength` (checked).
+    /// A `rect`, `disk` or `cylinder` light of strength `strength`
+    /// (checked): its radiance, over its area where normalised.
     fn area_light(&self, strength: Vec3) -> AreaLight {
+        let unit = self.area_shape(strength);
+        if self.normalize.unwrap_or(false) {
+            self.area_shape(strength / unit.area())
+        } else {
+            unit
+        }
+    }
+
+    /// The area light's shape, of radiance `radiance`.
+    fn area_shape(&self, radiance: Vec3) -> AreaLight {
         let v3 = |v: Option<[f32; 3]>| Vec3::from_array(v.unwrap_or_default());
-        let normal = v3(self.direction).normalize();
+        let (centre, normal) = (v3(self.position), v3(self.direction).normalize());
+        let radius = self.radius.unwrap_or(DEFAULT_DISK_RADIUS);
+        let (shape, w, h) = match self.kind.as_str() {
+            "cylinder" => {
+                let length = self.length.unwrap_or(DEFAULT_CYLINDER_LENGTH);
+                return AreaLight::cylinder(centre, normal, length, radius, radiance);
+            }
+            "rect" => (
+                AreaShape::Rect,
+                self.width.unwrap_or(1.0),
+                self.height.unwrap_or(1.0),
+            ),
+            _ => (
+                AreaShape::Disk,
+                self.width.unwrap_or(2.0 * radius),
+                self.height.unwrap_or(2.0 * radius),
+            ),
+        };
         // The height's axis: `up` square to the normal, else +Y, else +Z.
         let up = [self.up.map(Vec3::from_array), Some(Vec3::Y), Some(Vec3::Z)]
             .into_iter()
@@ -290,37 +324,14 @@ impl LightSpec {
             .unwrap_or(Vec3::Y)
             .normalize();
         let across = up.cross(normal);
-        let (shape, w, h) = match self.kind.as_str() {
-            "rect" => (
-                AreaShape::Rect,
-                self.width.unwrap_or(1.0),
-                self.height.unwrap_or(1.0),
-            ),
-            _ => {
-                let d = 2.0 * self.radius.unwrap_or(DEFAULT_DISK_RADIUS);
-                (
-                    AreaShape::Disk,
-                    self.width.unwrap_or(d),
-                    self.height.unwrap_or(d),
-                )
-            }
-        };
-        let light = |radiance| {
-            AreaLight::new(
-                shape,
-                v3(self.position),
-                0.5 * w * across,
-                0.5 * h * up,
-                normal,
-                radiance,
-            )
-        };
-        let unit = light(strength);
-        if self.normalize.unwrap_or(false) {
-            light(strength / unit.area())
-        } else {
-            unit
-        }
+        AreaLight::new(
+            shape,
+            centre,
+            0.5 * w * across,
+            0.5 * h * up,
+            normal,
+            radiance,
+        )
     }
 }
 

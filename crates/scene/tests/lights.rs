@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use cirrus_render::Light;
+use cirrus_render::{AreaShape, Light};
 use cirrus_scene::{Overrides, Scene, SceneDescription};
 use glam::Vec3;
 
@@ -177,7 +177,15 @@ fn bad_lights_are_errors_naming_the_file_and_the_light() {
             "type = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\ncone_angle = 20\ncone_softness = 2",
             "`cone_softness` 2 is not in [0, 1]",
         ),
-        ("type = \"cylinder\"", "cylinder lights are not rendered yet"),
+        (
+            "type = \"cylinder\"\nposition = [0, 0, 0]\ndirection = [1, 0, 0]\nlength = -2",
+            "`length` -2 is not positive: an area light needs an area",
+        ),
+        ("type = \"cylinder\"\nposition = [0, 0, 0]", "a cylinder light needs `direction`"),
+        (
+            "type = \"cylinder\"\nposition = [0, 0, 0]\ndirection = [1, 0, 0]\nwidth = 2",
+            "`width` does not apply to a cylinder light",
+        ),
         (
             "type = \"rect\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\nwidth = 0",
             "`width` 0 is not positive: an area light needs an area",
@@ -268,11 +276,28 @@ fn area_lights_take_their_size_orientation_and_normalisation() {
         direction = [0, -1, 0]
         radius = 0.5
         color = [1, 0.5, 0.25]
+        [[light]]
+        type = "cylinder"
+        position = [0, 1, 0]
+        direction = [0, 0, 3]
+        radius = 0.25
+        length = 4
+        intensity = 2
+        normalize = true
         "#,
     );
-    let [Light::Area(rect), Light::Area(disk)] = lights.as_slice() else {
+    let [Light::Area(rect), Light::Area(disk), Light::Area(tube)] = lights.as_slice() else {
         panic!("{lights:?}")
     };
+    assert_eq!(tube.shape(), AreaShape::Cylinder);
+    assert!((tube.area() - 2.0 * std::f32::consts::PI).abs() < 1e-5);
+    assert_eq!(tube.normal(), Vec3::Z, "its axis");
+    assert!(
+        (tube.radiance() - Vec3::splat(1.0 / std::f32::consts::PI))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
     assert_eq!(rect.area(), 1.0);
     assert_eq!(rect.normal(), -Vec3::Y);
     assert_eq!(

@@ -99,7 +99,9 @@ fn a_volume_its_material_and_transform_are_read() {
     let w = scene.warnings().join("\n");
     assert!(w.contains("inputs:roughness"), "{w}");
     assert!(
-        w.contains("no DistantLight, DomeLight, SphereLight, RectLight or DiskLight"),
+        w.contains(
+            "no DistantLight, DomeLight, SphereLight, RectLight, DiskLight or CylinderLight"
+        ),
         "{w}"
     );
 }
@@ -451,4 +453,53 @@ fn every_light_of_a_stage_is_read_with_its_transform_and_shaping() {
     let names = &out.layers.as_ref().unwrap().group_names;
     assert_eq!(names[3..], ["Moon", "Bulb", "Lamp", "Panel", "Round"]);
     assert!(out.stats.counters.nee_rays_sphere > 0);
+}
+
+#[test]
+fn a_cylinder_light_lies_along_its_x_axis_and_renders() {
+    let d = dir("cylinder");
+    let tube = r#"
+    def CylinderLight "Tube"
+    {
+        float inputs:length = 30
+        float inputs:radius = 1
+        float inputs:intensity = 40
+        bool treatAsLine = 1
+        double3 xformOp:translate = (150, 150, 100)
+        float3 xformOp:rotateXYZ = (0, 0, 90)
+        float3 xformOp:scale = (2, 1, 3)
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ", "xformOp:scale"]
+    }
+"#;
+    let body = format!("{}{tube}", volume("Cloud", "./cloud.vdb", "density"));
+    let p = write(&d, "tube.usda", &stage(&body));
+    let mut scene = Scene::load(&p).unwrap();
+    let w = scene.warnings().join("\n");
+    assert!(w.contains("/World/Tube: treatAsLine is not applied"), "{w}");
+    assert!(!w.contains("not rendered"), "{w}");
+    let l = &scene.description().lights;
+    // Its X axis turned 90 degrees about Z to +Y (scaled by 2), its
+    // length scaled by 2, its radius by the mean of the Y and Z scales.
+    assert_eq!(l.len(), 1, "{l:?}");
+    assert_eq!(
+        (l[0].kind.as_str(), l[0].name.as_deref()),
+        ("cylinder", Some("Tube"))
+    );
+    assert_eq!(l[0].position, Some([150.0, 150.0, 100.0]));
+    let axis = l[0].direction.unwrap();
+    assert!(
+        (axis[1] - 2.0).abs() < 1e-5 && axis[0].abs() < 1e-5,
+        "{axis:?}"
+    );
+    assert_eq!((l[0].length, l[0].radius), (Some(60.0), Some(2.0)));
+    assert_eq!(l[0].color, Some([40.0; 3]));
+    scene.apply(&Overrides {
+        res: Some((16, 12)),
+        spp: Some(2),
+        ..Default::default()
+    });
+    let out = scene.render().unwrap();
+    assert!(out.stats.counters.nee_rays_area > 0);
+    let mean: f32 = out.image.rgba.iter().map(|p| p[0]).sum::<f32>() / out.image.rgba.len() as f32;
+    assert!(mean > 0.0, "the tube lights the cloud");
 }

@@ -1,8 +1,8 @@
 //! UsdLux lights: the first `DistantLight` as the sun and the first
 //! `DomeLight` as the sky (the `[sun]` and `[environment]` tables), every
 //! other distant and dome light, every `SphereLight` (a spot where its
-//! `shaping:cone:angle` is authored) and every `RectLight` and `DiskLight`
-//! as a `[[light]]`.
+//! `shaping:cone:angle` is authored) and every `RectLight`, `DiskLight`
+//! and `CylinderLight` as a `[[light]]`.
 //!
 //! Emission is `intensity x 2^exposure x color` (UsdLux). A distant light's
 //! irradiance (what cirrus's sun is given in) is that value when
@@ -289,6 +289,52 @@ pub fn area(r: &mut Reader, path: &str, name: &str, kind: &str) -> Result<LightS
         up: Some(y.as_vec3().to_array()),
         width: Some(w as f32),
         height: Some(h as f32),
+        color: Some(strength.to_array()),
+        normalize: Some(normalize),
+        ..Default::default()
+    })
+}
+
+/// The `[[light]]` named `name` of the `CylinderLight` at `path`: its
+/// side along the light's X axis, its length scaled by the transform's X
+/// scale and its radius by the mean of the Y and Z scales, emitting
+/// outward (its caps dark). `treatAsLine` is named in a warning: the
+/// cylinder keeps its radius.
+pub fn cylinder(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
+    let p = r.stage.prim(path);
+    let t = r.time.start;
+    let strength = emission(r, path, 1.0)?;
+    let normalize = matches!(
+        value(&p, "inputs:normalize", t)?,
+        Some(openusd::sdf::Value::Bool(true))
+    );
+    if matches!(
+        value(&p, "treatAsLine", t)?,
+        Some(openusd::sdf::Value::Bool(true))
+    ) {
+        r.warn(format!(
+            "{path}: treatAsLine is not applied (the cylinder keeps its radius)"
+        ));
+    }
+    let world = world_at(&r.stage, path, t)?;
+    let [x, y, z] = [DVec3::X, DVec3::Y, DVec3::Z].map(|v| world.transform_vector3(v));
+    let length = input_number(&p, "length", t)?.unwrap_or(1.0) * x.length();
+    let radius = input_number(&p, "radius", t)?.unwrap_or(0.5) * 0.5 * (y.length() + z.length());
+    let centre = world.transform_point3(DVec3::ZERO);
+    let finite = centre.is_finite() && x.is_finite();
+    if !(finite && length > 0.0 && radius > 0.0) {
+        return Err(r.error(
+            path,
+            format!("a cylinder light needs a finite transform and a positive size (here length {length}, radius {radius})"),
+        ));
+    }
+    Ok(LightSpec {
+        kind: "cylinder".into(),
+        name: Some(name.into()),
+        position: Some(centre.as_vec3().to_array()),
+        direction: Some(x.as_vec3().to_array()),
+        length: Some(length as f32),
+        radius: Some(radius as f32),
         color: Some(strength.to_array()),
         normalize: Some(normalize),
         ..Default::default()

@@ -12,8 +12,8 @@
 //!   with its world transform (composed through its parents, instance
 //!   proxies included: each instance of a prototype is its own volume) and
 //!   bound material (`material.rs`);
-//! - every `DistantLight`, `DomeLight`, `SphereLight`, `RectLight` and
-//!   `DiskLight` (`lights.rs`);
+//! - every `DistantLight`, `DomeLight`, `SphereLight`, `RectLight`,
+//!   `DiskLight` and `CylinderLight` (`lights.rs`);
 //! - the camera the `RenderSettings` name, else the first `Camera`, and the
 //!   settings' resolution (`camera.rs`);
 //! - time: the stage's `startTimeCode`-`endTimeCode` become the frames
@@ -222,6 +222,7 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
                     "SphereLight",
                     "RectLight",
                     "DiskLight",
+                    "CylinderLight",
                     "Camera",
                     "RenderSettings",
                 ]
@@ -231,7 +232,7 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
         .collect();
     if !unsupported.is_empty() {
         r.warn(format!(
-            "{}: not rendered (cirrus renders volumes, distant, dome, sphere, rect and disk lights and a camera): {}",
+            "{}: not rendered (cirrus renders volumes, distant, dome, sphere, rect, disk and cylinder lights and a camera): {}",
             r.file,
             unsupported.join(", ")
         ));
@@ -251,7 +252,11 @@ fn describe(r: &mut Reader, prims: &[(String, String)]) -> Result<SceneDescripti
         &of(&["DistantLight"]),
         &of(&["DomeLight", "DomeLight_1"]),
         &of(&["SphereLight"]),
-        &[of(&["RectLight"]), of(&["DiskLight"])],
+        &[
+            of(&["RectLight"]),
+            of(&["DiskLight"]),
+            of(&["CylinderLight"]),
+        ],
         &mut desc,
     )?;
     view(r, &of(&["Camera"]), &of(&["RenderSettings"]), &mut desc)?;
@@ -276,7 +281,7 @@ fn lights(
     suns: &[String],
     domes: &[String],
     spheres: &[String],
-    [rects, disks]: &[Vec<String>; 2],
+    [rects, disks, cylinders]: &[Vec<String>; 3],
     desc: &mut SceneDescription,
 ) -> Result<()> {
     desc.sun = Some(match suns.first() {
@@ -308,6 +313,9 @@ fn lights(
             desc.lights.push(lights::area(r, p, &name(p), kind)?);
         }
     }
+    for p in cylinders {
+        desc.lights.push(lights::cylinder(r, p, &name(p))?);
+    }
     if crate::lights::light_group_names(desc).is_err() {
         r.warn(format!(
             "{}: {} lights are more light-group layers than the film keeps: they share `sun`, `sky` and `lights`",
@@ -327,7 +335,7 @@ fn lights(
     }
     if desc.lights.is_empty() && suns.is_empty() && domes.is_empty() {
         r.warn(format!(
-            "{}: the stage has no DistantLight, DomeLight, SphereLight, RectLight or DiskLight: the volumes are unlit",
+            "{}: the stage has no DistantLight, DomeLight, SphereLight, RectLight, DiskLight or CylinderLight: the volumes are unlit",
             r.file
         ));
     }
