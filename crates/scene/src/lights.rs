@@ -126,6 +126,12 @@ impl LightSpec {
         if let Some(key) = self.given().into_iter().find(|k| !takes.contains(k)) {
             return Err(format!("`{key}` does not apply to a {kind} light"));
         }
+        self.check_values()?;
+        self.check_kind()
+    }
+
+    /// Every value given finite and in range.
+    fn check_values(&self) -> std::result::Result<(), String> {
         let finite = |key: &str, v: &[f32]| {
             if v.iter().all(|x| x.is_finite()) {
                 Ok(())
@@ -144,11 +150,14 @@ impl LightSpec {
         at_least_zero("intensity", &[self.intensity.unwrap_or(1.0)])?;
         at_least_zero("color", &self.color.unwrap_or([1.0; 3]))?;
         finite("exposure", &[self.exposure.unwrap_or(0.0)])?;
-        if let Some(p) = self.position {
-            finite("position", &p)?;
+        for (key, v) in [("position", self.position), ("up", self.up)] {
+            v.map_or(Ok(()), |v| finite(key, &v))?;
         }
-        if let Some(r) = self.radius {
-            at_least_zero("radius", &[r])?;
+        for (key, v) in [("radius", self.radius), ("angle", self.angle)] {
+            v.map_or(Ok(()), |v| at_least_zero(key, &[v]))?;
+        }
+        if let Some(r) = self.rotation {
+            finite("rotation", &[r])?;
         }
         for (key, size) in [
             ("width", self.width),
@@ -164,9 +173,18 @@ impl LightSpec {
                 }
             }
         }
-        if let Some(u) = self.up {
-            finite("up", &u)?;
+        if let Some(d) = self.direction {
+            finite("direction", &d)?;
+            if Vec3::from_array(d).length_squared() == 0.0 {
+                return Err("`direction` is zero".into());
+            }
         }
+        Ok(())
+    }
+
+    /// What the light's kind needs: its position, direction, size, cone.
+    fn check_kind(&self) -> std::result::Result<(), String> {
+        let kind = self.kind.as_str();
         if matches!(kind, "disk" | "cylinder") && self.radius == Some(0.0) {
             return Err("`radius` 0: an area light needs an area".into());
         }
@@ -175,18 +193,6 @@ impl LightSpec {
             && (self.width.is_some() || self.height.is_some())
         {
             return Err("give a disk `radius`, or `width` and `height`, not both".into());
-        }
-        if let Some(a) = self.angle {
-            at_least_zero("angle", &[a])?;
-        }
-        if let Some(r) = self.rotation {
-            finite("rotation", &[r])?;
-        }
-        if let Some(d) = self.direction {
-            finite("direction", &d)?;
-            if Vec3::from_array(d).length_squared() == 0.0 {
-                return Err("`direction` is zero".into());
-            }
         }
         match kind {
             "distant" if self.direction.is_none() => {

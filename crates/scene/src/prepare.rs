@@ -97,21 +97,7 @@ pub fn prepare<'c>(
         .iter()
         .map(|v| plan(v, cache, moving, placement.precision()))
         .collect::<Result<Vec<_>>>()?;
-    let boxes: Vec<DBounds3> = plans
-        .iter()
-        .map(|p| match p.world_box {
-            Some(b) => Ok(b),
-            None => cache.density_box(p),
-        })
-        .collect::<Result<_>>()?;
-    let (centre, framed) = match (placement, plans.as_slice()) {
-        (Placement::OwnGrid, [one]) => own_grid(cache, one)?,
-        _ => {
-            let union = boxes.iter().fold(DBounds3::EMPTY, |u, &b| u.union(b));
-            let centre = union.centre();
-            (centre, union.relative_to(centre))
-        }
-    };
+    let (boxes, centre, framed) = render_space(placement, cache, &plans)?;
     let camera = match crate::moving::camera(desc, &settings, centre)? {
         Some(c) => c,
         None => camera(&settings, centre, framed),
@@ -172,6 +158,31 @@ pub fn prepare<'c>(
         grids_loaded: cache.grids_loaded(),
         load_seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The volumes' world boxes, and render space: its centre in the world
+/// and the boxes' union about it (what the camera frames).
+fn render_space(
+    placement: Placement,
+    cache: &mut VolumeCache,
+    plans: &[Plan],
+) -> Result<(Vec<DBounds3>, DVec3, Bounds3)> {
+    let boxes: Vec<DBounds3> = plans
+        .iter()
+        .map(|p| match p.world_box {
+            Some(b) => Ok(b),
+            None => cache.density_box(p),
+        })
+        .collect::<Result<_>>()?;
+    let (centre, framed) = match (placement, plans) {
+        (Placement::OwnGrid, [one]) => own_grid(cache, one)?,
+        _ => {
+            let union = boxes.iter().fold(DBounds3::EMPTY, |u, &b| u.union(b));
+            let centre = union.centre();
+            (centre, union.relative_to(centre))
+        }
+    };
+    Ok((boxes, centre, framed))
 }
 
 /// [`Placement::OwnGrid`]'s centre, the middle of the volume's brick grid
