@@ -1,6 +1,7 @@
 """Rendering a scene file with a cirrus binary from the benchmark scripts
-(`tools/many_lights.py`, `tools/equiangular.py`): the RGB it wrote and the
-render's wall time from its `--stats`."""
+(`tools/many_lights.py`, `tools/equiangular.py`,
+`tools/rect_light_sampling.py`): the RGB it wrote and the render's wall
+time from its `--stats`; and the corpus cloud as thin fog they share."""
 
 from __future__ import annotations
 
@@ -10,6 +11,17 @@ from pathlib import Path
 
 import numpy as np
 import OpenEXR
+
+CLOUD = Path(__file__).resolve().parents[1] / "data" / "cloud.vdb"
+
+# The corpus cloud as thin fog (a `[[volume]]` table): density scale 0.1,
+# albedo 0.8, g 0.3.
+CLOUD_FOG = f"""[[volume]]
+file = "{CLOUD}"
+density_scale = 0.1
+albedo = 0.8
+g = 0.3
+"""
 
 
 def render_rgb(cirrus: str, text: str, d: Path, name: str) -> tuple[np.ndarray, float]:

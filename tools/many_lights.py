@@ -23,10 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from cirrus_runs import render_rgb
+from cirrus_runs import CLOUD_FOG, render_rgb
 
 REPO = Path(__file__).resolve().parents[1]
-CLOUD = REPO / "data" / "cloud.vdb"
 # The cloud's world box (index bbox of data/cloud.vdb, voxel size 1).
 LO, HI = np.array([33.0, 25.0, 32.0]), np.array([266.0, 140.0, 167.0])
 
@@ -66,12 +65,7 @@ light_sampling = "{sampling}"
 [environment]
 radiance = [0.002, 0.003, 0.005]
 {lights}
-[[volume]]
-file = "{CLOUD}"
-density_scale = 0.1
-albedo = 0.8
-g = 0.3
-"""
+{CLOUD_FOG}"""
 
 
 def main() -> None:

@@ -21,10 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cirrus_runs import render_rgb
+from cirrus_runs import CLOUD_FOG, render_rgb
 
-REPO = Path(__file__).resolve().parents[1]
-CLOUD = REPO / "data" / "cloud.vdb"
 
 
 def scene(spp: int, seed: int, width: float) -> str:
@@ -43,12 +41,7 @@ width = {width}
 height = {width * 0.6}
 color = [1, 0.9, 0.8]
 intensity = 2
-[[volume]]
-file = "{CLOUD}"
-density_scale = 0.1
-albedo = 0.8
-g = 0.3
-"""
+{CLOUD_FOG}"""
 
 
 def main() -> None:

@@ -37,6 +37,14 @@ fn input_number(p: &Prim, name: &str, t: f64) -> Result<Option<f64>> {
     })
 }
 
+/// Whether the bool attribute `name` is authored true.
+fn flag(p: &Prim, name: &str, t: f64) -> Result<bool> {
+    Ok(matches!(
+        value(p, name, t)?,
+        Some(openusd::sdf::Value::Bool(true))
+    ))
+}
+
 /// `intensity x 2^exposure x color`, with the light's intensity fallback.
 fn emission(r: &mut Reader, path: &str, intensity_fallback: f64) -> Result<Vec3> {
     let p = r.stage.prim(path);
@@ -47,9 +55,7 @@ fn emission(r: &mut Reader, path: &str, intensity_fallback: f64) -> Result<Vec3>
         Some(c) => c,
         None => attr_triple(&p, "color", t)?.unwrap_or([1.0; 3]),
     };
-    if value(&p, "inputs:enableColorTemperature", t)?
-        .is_some_and(|v| matches!(v, openusd::sdf::Value::Bool(true)))
-    {
+    if flag(&p, "inputs:enableColorTemperature", t)? {
         r.warn(format!("{path}: colour temperature is not applied"));
     }
     let scale = intensity * exposure.exp2();
@@ -65,10 +71,7 @@ pub fn distant(r: &mut Reader, path: &str) -> Result<SunSpec> {
     let p = r.stage.prim(path);
     let t = r.time.start;
     let angle = input_number(&p, "angle", t)?.unwrap_or(0.53);
-    let normalize = matches!(
-        value(&p, "inputs:normalize", t)?,
-        Some(openusd::sdf::Value::Bool(true))
-    );
+    let normalize = flag(&p, "inputs:normalize", t)?;
     let radiance = emission(r, path, 50000.0)?;
     let half = (0.5 * angle).to_radians();
     let irradiance = if normalize || angle <= 0.0 {
@@ -176,14 +179,8 @@ pub fn sphere(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
     let p = r.stage.prim(path);
     let t = r.time.start;
     let strength = emission(r, path, 1.0)?;
-    let flag = |name: &str| -> Result<bool> {
-        Ok(matches!(
-            value(&p, name, t)?,
-            Some(openusd::sdf::Value::Bool(true))
-        ))
-    };
-    let normalize = flag("inputs:normalize")?;
-    let as_point = flag("treatAsPoint")?;
+    let normalize = flag(&p, "inputs:normalize", t)?;
+    let as_point = flag(&p, "treatAsPoint", t)?;
     let radius = input_number(&p, "radius", t)?.unwrap_or(0.5);
     let world = world_at(&r.stage, path, t)?;
     let position = world.transform_point3(DVec3::ZERO);
@@ -250,10 +247,7 @@ pub fn area(r: &mut Reader, path: &str, name: &str, kind: &str) -> Result<LightS
     let p = r.stage.prim(path);
     let t = r.time.start;
     let strength = emission(r, path, 1.0)?;
-    let normalize = matches!(
-        value(&p, "inputs:normalize", t)?,
-        Some(openusd::sdf::Value::Bool(true))
-    );
+    let normalize = flag(&p, "inputs:normalize", t)?;
     let world = world_at(&r.stage, path, t)?;
     let (x, y) = (
         world.transform_vector3(DVec3::X),
@@ -304,14 +298,8 @@ pub fn cylinder(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
     let p = r.stage.prim(path);
     let t = r.time.start;
     let strength = emission(r, path, 1.0)?;
-    let normalize = matches!(
-        value(&p, "inputs:normalize", t)?,
-        Some(openusd::sdf::Value::Bool(true))
-    );
-    if matches!(
-        value(&p, "treatAsLine", t)?,
-        Some(openusd::sdf::Value::Bool(true))
-    ) {
+    let normalize = flag(&p, "inputs:normalize", t)?;
+    if flag(&p, "treatAsLine", t)? {
         r.warn(format!(
             "{path}: treatAsLine is not applied (the cylinder keeps its radius)"
         ));
