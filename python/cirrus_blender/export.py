@@ -264,9 +264,11 @@ class Export:
         intensity = [float(c) * float(light.energy) / (4.0 * math.pi) for c in light.color]
         entry: dict = {"name": obj.name, "position": list(position)}
         if radius > 0.0:
-            # A ball of radiance I / (pi r^2) sends I.
+            # A ball of radiance I / (pi r^2) sends I; camera rays see it
+            # where the lamp's object is visible to the camera, as in Cycles.
             entry.update({"type": "sphere", "radius": radius,
-                          "color": [i / (math.pi * radius * radius) for i in intensity]})
+                          "color": [i / (math.pi * radius * radius) for i in intensity],
+                          "visible_to_camera": bool(obj.visible_camera)})
         else:
             entry.update({"type": "point", "color": intensity})
         if light.type == "SPOT":
@@ -309,6 +311,7 @@ class Export:
             "width": width,
             "height": height,
             "color": [float(c) * scale for c in light.color],
+            "visible_to_camera": bool(obj.visible_camera),
         })
 
     def world(self) -> None:

@@ -1,10 +1,16 @@
 //! White furnace: a non-absorbing medium in a constant environment,
 //! without a sun, is invisible. Every pixel must equal the environment
-//! whatever the density, with unlimited scattering.
+//! whatever the density, with unlimited scattering; so under a sun that
+//! covers the sphere, and inside a sphere light.
 
 mod common;
 
-use cirrus_render::{render, IntegratorKind, Lights, MajorantMode, Sun, TransmittanceEstimator};
+use std::f32::consts::PI;
+
+use cirrus_render::{
+    render, DistanceSampling, IntegratorKind, Lights, MajorantMode, Rendered, SphereLight, Sun,
+    TransmittanceEstimator,
+};
 use glam::Vec3;
 
 #[test]
@@ -96,24 +102,48 @@ fn a_sun_covering_the_sphere_is_a_furnace_too() {
     // E / (4 pi): the same furnace, but through the sun's own sampling,
     // disc test and MIS weights.
     let irradiance = 2.0f32;
-    let l = irradiance / (4.0 * std::f32::consts::PI);
-    let sun = Sun::new(
-        Vec3::new(0.3, -1.0, 0.2),
-        Vec3::splat(irradiance),
-        2.0 * std::f32::consts::PI,
-    );
+    let l = irradiance / (4.0 * PI);
+    let sun = Sun::new(Vec3::new(0.3, -1.0, 0.2), Vec3::splat(irradiance), 2.0 * PI);
     let medium = common::medium(common::cloud_field(4), 8.0, 1.0, 0.5);
     let scene = common::scene(medium, 16, Lights::sun_and_sky(Some(sun), None));
     let out = render(&scene, &common::settings(IntegratorKind::Path, 64, 7));
+    assert_uniform("sphere sun", &out, l);
+}
+
+#[test]
+fn inside_a_sphere_light_the_cloud_is_a_furnace_too() {
+    // A ball of radiance L around the cloud and the camera lights every
+    // point inside it with L from every direction: the furnace again,
+    // through the ball's sampling from inside and the rays that leave it
+    // (camera rays see its inside too).
+    let (l, r) = (0.6f32, 40.0f32);
+    let medium = common::medium(common::cloud_field(4), 8.0, 1.0, 0.3);
+    let ball =
+        SphereLight::new(Vec3::splat(0.5), r, Vec3::splat(l * PI * r * r)).seen_by_camera(true);
+    let scene = common::scene(medium, 16, Lights::new([ball.into()]));
+    for sampling in [DistanceSampling::FreeFlight, DistanceSampling::Equiangular] {
+        let mut settings = common::settings(IntegratorKind::Path, 64, 9);
+        settings.distance_sampling = sampling;
+        let out = render(&scene, &settings);
+        assert!(out.stats.counters.nee_rays_sphere > 1000);
+        let equiangular = out.stats.counters.equiangular_samples > 0;
+        assert_eq!(equiangular, sampling == DistanceSampling::Equiangular);
+        assert_uniform(&format!("inside a ball, {}", sampling.name()), &out, l);
+    }
+}
+
+/// Every pixel of `out` is `l` in green, within 5 of its standard errors
+/// (and f32 rounding), and pooled over the image within 4.
+fn assert_uniform(label: &str, out: &Rendered, l: f32) {
     let img = &out.image;
     let (mut diff_sum, mut var_sum) = (0f64, 0f64);
     for y in 0..img.height {
         for x in 0..img.width {
             let (px, se) = (img.pixel(x, y), img.std_error(x, y));
-            // Same per-pixel and pooled bounds as above.
+            // Same per-pixel and pooled bounds as the furnace's above.
             assert!(
                 (px[1] - l).abs() <= 5.0 * se[1] + 1e-5 * l,
-                "pixel ({x}, {y}) = {}",
+                "{label}: pixel ({x}, {y}) = {}",
                 px[1]
             );
             diff_sum += (px[1] - l) as f64;
@@ -121,6 +151,6 @@ fn a_sun_covering_the_sphere_is_a_furnace_too() {
         }
     }
     let pooled = diff_sum / var_sum.sqrt();
-    eprintln!("sphere sun: pooled z {pooled:.3}");
-    assert!(pooled.abs() <= 4.0, "pooled z {pooled}");
+    eprintln!("{label}: pooled z {pooled:.3}");
+    assert!(pooled.abs() <= 4.0, "{label}: pooled z {pooled}");
 }

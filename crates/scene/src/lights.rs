@@ -49,7 +49,7 @@ const KINDS: [&str; 8] = [
 fn keys_of(kind: &str) -> &'static [&'static str] {
     match kind {
         "distant" => &["direction", "angle"],
-        "sphere" => &["position", "radius", "normalize"],
+        "sphere" => &["position", "radius", "normalize", "visible_to_camera"],
         "point" => &["position"],
         "spot" => &[
             "position",
@@ -58,6 +58,7 @@ fn keys_of(kind: &str) -> &'static [&'static str] {
             "normalize",
             "cone_angle",
             "cone_softness",
+            "visible_to_camera",
         ],
         "rect" => &[
             "position",
@@ -66,6 +67,7 @@ fn keys_of(kind: &str) -> &'static [&'static str] {
             "width",
             "height",
             "normalize",
+            "visible_to_camera",
         ],
         "disk" => &[
             "position",
@@ -75,8 +77,16 @@ fn keys_of(kind: &str) -> &'static [&'static str] {
             "width",
             "height",
             "normalize",
+            "visible_to_camera",
         ],
-        "cylinder" => &["position", "direction", "radius", "length", "normalize"],
+        "cylinder" => &[
+            "position",
+            "direction",
+            "radius",
+            "length",
+            "normalize",
+            "visible_to_camera",
+        ],
         _ => &["map", "rotation"],
     }
 }

@@ -37,12 +37,14 @@ fn a_sphere_light_sends_its_radiance_times_its_projected_area() {
         exposure = 1
         color = [1, 0.5, 0.25]
         normalize = true
+        visible_to_camera = true
         "#,
     );
     assert_eq!(lights.len(), 1, "no default sun or sky beside a [[light]]");
     let Light::Sphere(s) = &lights[0] else {
         panic!("{:?}", lights[0])
     };
+    assert!(s.camera_visible());
     assert!(
         (s.intensity() - Vec3::new(1.0, 0.5, 0.25))
             .abs()
@@ -58,6 +60,7 @@ fn a_sphere_light_sends_its_radiance_times_its_projected_area() {
         panic!()
     };
     assert!((s.intensity().x - std::f32::consts::PI).abs() < 1e-5);
+    assert!(!s.camera_visible(), "hidden from the camera by default");
     // A point's strength is its intensity.
     let lights = lights_of("[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = 3\n");
     let Light::Sphere(s) = &lights[0] else {
@@ -196,6 +199,10 @@ fn bad_lights_are_errors_naming_the_file_and_the_light() {
         ),
         ("type = \"rect\"\nposition = [0, 0, 0]", "a rect light needs `direction`"),
         ("type = \"lamp\"", "unknown type \"lamp\""),
+        (
+            "type = \"point\"\nposition = [0, 0, 0]\nvisible_to_camera = true",
+            "`visible_to_camera` does not apply to a point light",
+        ),
         ("type = \"distant\"\ndirection = [0, -1, 0]\nradius = 1", "`radius` does not apply to a distant light"),
         ("type = \"point\"\nposition = [0, 0, 0]\ncolor = [1, -1, 1]", "`color` is negative"),
     ] {
@@ -284,12 +291,14 @@ fn area_lights_take_their_size_orientation_and_normalisation() {
         length = 4
         intensity = 2
         normalize = true
+        visible_to_camera = true
         "#,
     );
     let [Light::Area(rect), Light::Area(disk), Light::Area(tube)] = lights.as_slice() else {
         panic!("{lights:?}")
     };
     assert_eq!(tube.shape(), AreaShape::Cylinder);
+    assert!(tube.camera_visible() && !rect.camera_visible());
     assert!((tube.area() - 2.0 * std::f32::consts::PI).abs() < 1e-5);
     assert_eq!(tube.normal(), Vec3::Z, "its axis");
     assert!(

@@ -13,20 +13,27 @@
 //! Cycles' point lights do the same): density `1 / (2 pi (1 - cos
 //! theta_max))` with `sin theta_max = r / d`, the radiance `L` along each
 //! (a sphere of uniform radiance looks like a disc of uniform radiance).
-//! A point light is a delta: `I / d^2` along the one direction. The ball
-//! emits outward only: from inside it nothing is received.
+//! A point light is a delta: `I / d^2` along the one direction. A point
+//! inside the ball receives its radiance from every direction, as inside
+//! Cycles' point lamps (fog within a lamp's radius glows): directions are
+//! drawn uniformly over the sphere, density `1 / 4 pi`, each to where it
+//! leaves the ball. Whether a direction brings light thus depends only on
+//! where it starts (outside: if it meets the ball; inside: always), which
+//! sampling and rays that meet the ball share, so the two weigh alike.
 
 use std::f32::consts::PI;
 
 use glam::Vec3;
 
 use super::LightSample;
-use crate::sampling::uniform_cone;
+use crate::sampling::{uniform_cone, uniform_sphere, UNIFORM_SPHERE_PDF};
 
-/// A spot light's cone about its axis. The light's intensity is scaled by
-/// `smoothstep(cos_outer, cos_inner, cos theta)` at angle `theta` off the
-/// axis, where `cos_inner = cos_outer + softness (1 - cos_outer)`: full
-/// inside the inner cone, none outside the cone's angle (Cycles' spot
+/// A spot light's cone about its axis. The light's radiance along a
+/// direction `theta` off the axis (from the light toward what it lights;
+/// for a ball, each of its points' emission, as Cycles' spot lamps) is
+/// scaled by `smoothstep(cos_outer, cos_inner, cos theta)`, where
+/// `cos_inner = cos_outer + softness (1 - cos_outer)`: full inside the
+/// inner cone, none outside the cone's angle (Cycles' spot
 /// blend, UsdLux ShapingAPI's cone angle and softness).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spot {
@@ -158,7 +165,8 @@ impl SphereLight {
 
     /// `1 - cos theta_max` of the cone the ball subtends from distance
     /// `d2.sqrt()` to its centre, as `sin^2 / (1 + cos)` so that a small
-    /// far ball keeps its solid angle; `None` from inside the ball.
+    /// far ball keeps its solid angle; `None` from inside the ball (every
+    /// direction sees it).
     #[inline]
     fn cone(&self, d2: f32) -> Option<f32> {
         let r2 = self.radius * self.radius;
@@ -171,7 +179,8 @@ impl SphereLight {
 
     /// Samples the light from `p`: a point's one direction, or a direction
     /// uniform in the cone the ball subtends with the distance to its near
-    /// surface. From inside the ball, a zero-density sample.
+    /// surface; from inside the ball, a direction uniform over the sphere
+    /// with the distance to where it leaves the ball.
     #[inline]
     pub fn sample(&self, p: Vec3, u1: f32, u2: f32) -> LightSample {
         let to_centre = self.position - p;
@@ -187,27 +196,28 @@ impl SphereLight {
             };
         }
         let Some(one_minus_cos) = self.cone(d2) else {
+            let to_light = uniform_sphere(u1, u2);
             return LightSample {
-                to_light: axis,
-                radiance: Vec3::ZERO,
-                pdf: Some(0.0),
-                distance: 0.0,
+                to_light,
+                radiance: self.radiance() * self.falloff(-to_light),
+                pdf: Some(UNIFORM_SPHERE_PDF),
+                distance: self.exit_distance(to_centre, to_light),
             };
         };
         let to_light = uniform_cone(axis, one_minus_cos, u1, u2);
         let distance = self.hit_distance(to_centre, to_light).unwrap_or(d);
         LightSample {
             to_light,
-            radiance: self.radiance() * self.falloff(-axis),
+            radiance: self.radiance() * self.falloff(-to_light),
             pdf: Some(1.0 / (2.0 * PI * one_minus_cos)),
             distance,
         }
     }
 
-    /// Where a ray from `p` along unit `dir` first meets the ball's outside
-    /// within `t_max`: the distance, the radiance it sees there and the
-    /// density with which [`Self::sample`] at `p` draws `dir`. `None` for
-    /// a point, a miss, or from inside the ball (which emits outward only).
+    /// Where a ray from `p` along unit `dir` first meets the ball within
+    /// `t_max` (its outside; from inside, where it leaves): the distance,
+    /// the radiance it sees there and the density with which
+    /// [`Self::sample`] at `p` draws `dir`. `None` for a point or a miss.
     #[inline]
     pub fn hit(&self, p: Vec3, dir: Vec3, t_max: f32) -> Option<(f32, Vec3, f32)> {
         if self.is_point() {
@@ -215,13 +225,13 @@ impl SphereLight {
         }
         let to_centre = self.position - p;
         let d2 = to_centre.length_squared();
-        let one_minus_cos = self.cone(d2)?;
+        let l = self.radiance() * self.falloff(-dir);
+        let Some(one_minus_cos) = self.cone(d2) else {
+            let t = self.exit_distance(to_centre, dir);
+            return (t < t_max).then_some((t, l, UNIFORM_SPHERE_PDF));
+        };
         let t = self.hit_distance(to_centre, dir)?;
-        (t < t_max).then(|| {
-            let axis = to_centre / d2.sqrt();
-            let l = self.radiance() * self.falloff(-axis);
-            (t, l, 1.0 / (2.0 * PI * one_minus_cos))
-        })
+        (t < t_max).then_some((t, l, 1.0 / (2.0 * PI * one_minus_cos)))
     }
 
     /// The near root of the ray from the ball's outside (`to_centre` from
@@ -236,6 +246,15 @@ impl SphereLight {
         let perp2 = (to_centre - b * dir).length_squared();
         let h2 = self.radius * self.radius - perp2;
         (b > 0.0 && h2 >= 0.0).then(|| (b - h2.sqrt()).max(0.0))
+    }
+
+    /// The far root of the ray from inside the ball (`to_centre` from the
+    /// origin to the centre) along unit `dir`: where it leaves.
+    #[inline]
+    fn exit_distance(&self, to_centre: Vec3, dir: Vec3) -> f32 {
+        let b = to_centre.dot(dir);
+        let perp2 = (to_centre - b * dir).length_squared();
+        b + (self.radius * self.radius - perp2).max(0.0).sqrt()
     }
 
     /// What the light sends toward `p` unoccluded, in luminance of the
@@ -272,22 +291,28 @@ mod tests {
     #[test]
     fn sampled_directions_meet_the_ball_and_the_hit_agrees() {
         let l = SphereLight::new(Vec3::new(1.0, 2.0, 3.0), 0.7, Vec3::splat(2.0));
-        let p = Vec3::new(-1.0, 0.5, 0.0);
-        for k in 0..64 {
-            let (u1, u2) = ((k as f32 + 0.5) / 64.0, (k as f32 * 0.618).fract());
-            let s = l.sample(p, u1, u2);
-            let on = p + s.distance * s.to_light;
-            assert!(((on - l.position()).length() - 0.7).abs() < 1e-4);
-            let (t, radiance, pdf) = l.hit(p, s.to_light, f32::INFINITY).unwrap();
-            assert!((t - s.distance).abs() < 1e-4);
-            assert_eq!(radiance, s.radiance);
-            assert_eq!(Some(pdf), s.pdf);
+        // From outside, and from inside (where every direction sees it).
+        let inside = l.position() + Vec3::new(0.2, -0.3, 0.1);
+        for p in [Vec3::new(-1.0, 0.5, 0.0), inside] {
+            for k in 0..64 {
+                let (u1, u2) = ((k as f32 + 0.5) / 64.0, (k as f32 * 0.618).fract());
+                let s = l.sample(p, u1, u2);
+                let on = p + s.distance * s.to_light;
+                assert!(((on - l.position()).length() - 0.7).abs() < 1e-4);
+                let (t, radiance, pdf) = l.hit(p, s.to_light, f32::INFINITY).unwrap();
+                assert!((t - s.distance).abs() < 1e-4);
+                assert_eq!(radiance, s.radiance);
+                assert_eq!(Some(pdf), s.pdf);
+            }
         }
-        assert!(l.hit(p, -Vec3::X, f32::INFINITY).is_none(), "a miss");
         assert!(
-            l.hit(l.position(), Vec3::X, f32::INFINITY).is_none(),
-            "inside"
+            l.hit(Vec3::new(-1.0, 0.5, 0.0), -Vec3::X, f32::INFINITY)
+                .is_none(),
+            "a miss"
         );
+        let (_, radiance, pdf) = l.hit(inside, Vec3::X, f32::INFINITY).unwrap();
+        assert_eq!((radiance, pdf), (l.radiance(), 1.0 / (4.0 * PI)));
+        let p = Vec3::new(-1.0, 0.5, 0.0);
         assert!(
             l.hit(p, (l.position() - p).normalize(), 1.0).is_none(),
             "beyond t_max"
