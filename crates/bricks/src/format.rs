@@ -176,6 +176,27 @@ impl Fields<'_> {
 
 /// Loads a `.cbrk` by memory map; the volume's data stays in the map.
 pub fn read_cbrk(path: &Path) -> Result<BrickVolume, BrickError> {
+    let map = map_checked(path)?;
+    let header = Header::read(&map, path)?;
+    let map = Arc::new(map);
+    let mut f = Fields(&map, TABLE_AT);
+    let mut table = Vec::new();
+    for k in 0..SECTIONS {
+        let (off, len) = (f.u64(), f.u64());
+        let end = off.checked_add(len).filter(|&e| e <= map.len() as u64);
+        if end.is_none() || off % ALIGN as u64 != 0 {
+            return Err(err(
+                path,
+                format!("section {k} [{off}, +{len}) lies outside the file or is misaligned"),
+            ));
+        }
+        table.push((off as usize, len as usize));
+    }
+    sections(header, &map, &table, path)
+}
+
+/// The file mapped, its length, magic, version and checksum checked.
+fn map_checked(path: &Path) -> Result<memmap2::Mmap, BrickError> {
     let file = std::fs::File::open(path).map_err(|e| err(path, e.to_string()))?;
     // SAFETY: the map is read-only; like every reader of a mapped file we
     // rely on no other process truncating or rewriting it while it is open
@@ -194,8 +215,7 @@ pub fn read_cbrk(path: &Path) -> Result<BrickVolume, BrickError> {
     if &map[..8] != MAGIC {
         return Err(err(path, "not a cirrus brick file (bad magic)"));
     }
-    let mut f = Fields(&map, 8);
-    let version = f.u32();
+    let version = Fields(&map, 8).u32();
     if version != VERSION {
         return Err(err(
             path,
@@ -213,91 +233,116 @@ pub fn read_cbrk(path: &Path) -> Result<BrickVolume, BrickError> {
             "checksum mismatch: the file is corrupt or truncated",
         ));
     }
-    let precision =
-        Precision::from_code(f.u32()).ok_or_else(|| err(path, "unknown precision code"))?;
-    let origin = IVec3::new(f.u32() as i32, f.u32() as i32, f.u32() as i32);
-    let dims = [f.u32(), f.u32(), f.u32()];
-    let level_count = f.u32() as usize;
-    let mut m = [0f64; 16];
-    m.iter_mut().for_each(|x| *x = f.f64());
-    let mut info = SourceInfo {
-        active_voxels: f.u64(),
-        bricks_stored: f.u64(),
-        bricks_constant: f.u64(),
-        bricks_empty: f.u64(),
-        sanitized_voxels: f.u64(),
-        ..Default::default()
-    };
-    info.max_error = f32::from_bits(f.u32());
-    if level_count > MAX_LEVELS {
-        return Err(err(
-            path,
-            format!("{level_count} levels (at most {MAX_LEVELS})"),
-        ));
-    }
-    let index_to_world = DMat4::from_cols_array(&m);
-    if !m.iter().all(|x| x.is_finite()) || index_to_world.determinant() == 0.0 {
-        return Err(err(path, "transform is singular or not finite"));
-    }
-    let map = Arc::new(map);
-    let mut f = Fields(&map, TABLE_AT);
-    let mut table = Vec::new();
-    for k in 0..SECTIONS {
-        let (off, len) = (f.u64(), f.u64());
-        let end = off.checked_add(len).filter(|&e| e <= map.len() as u64);
-        if end.is_none() || off % ALIGN as u64 != 0 {
+    Ok(map)
+}
+
+/// The header's fixed fields, checked.
+struct Header {
+    precision: Precision,
+    origin: IVec3,
+    dims: [u32; 3],
+    level_count: usize,
+    index_to_world: DMat4,
+    info: SourceInfo,
+}
+
+impl Header {
+    fn read(map: &[u8], path: &Path) -> Result<Self, BrickError> {
+        let mut f = Fields(map, 12);
+        let precision =
+            Precision::from_code(f.u32()).ok_or_else(|| err(path, "unknown precision code"))?;
+        let origin = IVec3::new(f.u32() as i32, f.u32() as i32, f.u32() as i32);
+        let dims = [f.u32(), f.u32(), f.u32()];
+        let level_count = f.u32() as usize;
+        let mut m = [0f64; 16];
+        m.iter_mut().for_each(|x| *x = f.f64());
+        let mut info = SourceInfo {
+            active_voxels: f.u64(),
+            bricks_stored: f.u64(),
+            bricks_constant: f.u64(),
+            bricks_empty: f.u64(),
+            sanitized_voxels: f.u64(),
+            ..Default::default()
+        };
+        info.max_error = f32::from_bits(f.u32());
+        if level_count > MAX_LEVELS {
             return Err(err(
                 path,
-                format!("section {k} [{off}, +{len}) lies outside the file or is misaligned"),
+                format!("{level_count} levels (at most {MAX_LEVELS})"),
             ));
         }
-        table.push((off as usize, len as usize));
+        let index_to_world = DMat4::from_cols_array(&m);
+        if !m.iter().all(|x| x.is_finite()) || index_to_world.determinant() == 0.0 {
+            return Err(err(path, "transform is singular or not finite"));
+        }
+        Ok(Self {
+            precision,
+            origin,
+            dims,
+            level_count,
+            index_to_world,
+            info,
+        })
     }
-    let mut f = Fields(&map, LEVEL_DIMS_AT);
+}
+
+/// Section `(offset, len)` of the map as `count` values of `T`.
+fn section<T: bytemuck::Pod>(
+    map: &Arc<memmap2::Mmap>,
+    (offset, len): (usize, usize),
+    count: usize,
+    what: &str,
+    path: &Path,
+) -> Result<Section<T>, BrickError> {
+    if len != count.saturating_mul(std::mem::size_of::<T>()) {
+        return Err(err(
+            path,
+            format!("{what} holds {len} bytes, expected {count} values"),
+        ));
+    }
+    Ok(Section::mapped(map.clone(), offset, len))
+}
+
+/// The volume over the map's sections (`table`), each checked against
+/// the header: sizes, brick references, the bounds levels' dims.
+fn sections(
+    header: Header,
+    map: &Arc<memmap2::Mmap>,
+    table: &[(usize, usize)],
+    path: &Path,
+) -> Result<BrickVolume, BrickError> {
+    let Header {
+        precision,
+        origin,
+        dims,
+        level_count,
+        index_to_world,
+        mut info,
+    } = header;
+    let mut f = Fields(map, LEVEL_DIMS_AT);
     let level_dims: Vec<[u32; 3]> = (0..MAX_LEVELS)
         .map(|_| [f.u32(), f.u32(), f.u32()])
         .collect();
-
-    fn section<T: bytemuck::Pod>(
-        map: &Arc<memmap2::Mmap>,
-        (offset, len): (usize, usize),
-        count: usize,
-        what: &str,
-        path: &Path,
-    ) -> Result<Section<T>, BrickError> {
-        if len != count.saturating_mul(std::mem::size_of::<T>()) {
-            return Err(err(
-                path,
-                format!("{what} holds {len} bytes, expected {count} values"),
-            ));
-        }
-        Ok(Section::mapped(map.clone(), offset, len))
-    }
     let bricks = dims
         .iter()
         .try_fold(1usize, |a, &d| a.checked_mul(d as usize))
         .ok_or_else(|| err(path, "dims overflow"))?;
     info.grid_name =
         String::from_utf8_lossy(&map[table[0].0..table[0].0 + table[0].1]).into_owned();
-    let map_s: Section<u32> = section(&map, table[1], bricks, "brick map", path)?;
+    let map_s: Section<u32> = section(map, table[1], bricks, "brick map", path)?;
     let elem = precision.bytes_per_voxel();
     let stored = table[4].1 / (512 * elem);
-    let constants: Section<f32> = section(&map, table[2], table[2].1 / 4, "constants", path)?;
-    let ranges: Section<f32> = section(
-        &map,
-        table[3],
-        if precision == Precision::U8 {
-            2 * stored
-        } else {
-            0
-        },
-        "ranges",
-        path,
-    )?;
+    let constants: Section<f32> = section(map, table[2], table[2].1 / 4, "constants", path)?;
+    let range_count = if precision == Precision::U8 {
+        2 * stored
+    } else {
+        0
+    };
+    let ranges: Section<f32> = section(map, table[3], range_count, "ranges", path)?;
     let atlas = match precision {
-        Precision::F32 => Atlas::F32(section(&map, table[4], stored * 512, "atlas", path)?),
-        Precision::F16 => Atlas::F16(section(&map, table[4], stored * 512, "atlas", path)?),
-        Precision::U8 => Atlas::U8(section(&map, table[4], stored * 512, "atlas", path)?),
+        Precision::F32 => Atlas::F32(section(map, table[4], stored * 512, "atlas", path)?),
+        Precision::F16 => Atlas::F16(section(map, table[4], stored * 512, "atlas", path)?),
+        Precision::U8 => Atlas::U8(section(map, table[4], stored * 512, "atlas", path)?),
     };
     for &bits in map_s.iter() {
         let ok = match BrickRef::decode(bits) {
@@ -321,7 +366,7 @@ pub fn read_cbrk(path: &Path) -> Result<BrickVolume, BrickError> {
         let cells = ld.iter().map(|&d| d as usize).product::<usize>();
         levels.push(BoundsLevel {
             dims: ld,
-            cells: section(&map, table[5 + k], 2 * cells, "bounds level", path)?,
+            cells: section(map, table[5 + k], 2 * cells, "bounds level", path)?,
         });
         expect = ld.map(|d| d.div_ceil(2));
     }
