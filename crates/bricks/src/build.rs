@@ -274,7 +274,50 @@ impl Builder {
     }
 
     pub(crate) fn finish_timed(mut self, clock: &Stages) -> Result<BrickVolume, BrickError> {
-        // 1. Stored bricks in leaf order.
+        let n = self.number_stored();
+        clock.lap("atlas numbered and compacted");
+        let constants = self.settle_map(n)?;
+        let total = constants.len();
+        let count = self.map.len() as u64;
+        let mut info = self.info;
+        info.max_error = f32::from_bits(self.stats.max_error_bits.load(Ordering::Relaxed));
+        info.sanitized_voxels += self.stats.sanitized.load(Ordering::Relaxed);
+        info.bricks_stored = n as u64;
+        info.bricks_constant = total as u64;
+        info.bricks_empty = count - n as u64 - total as u64;
+        drop(self.states);
+        drop(self.tile_values);
+        let atlas = match self.atlas {
+            AtlasBuf::F32(v) => Atlas::F32(v.into()),
+            AtlasBuf::F16(v) => Atlas::F16(v.into()),
+            AtlasBuf::U8(v) => Atlas::U8(v.into()),
+        };
+        let ranges: Vec<f32> = self.ranges.into_iter().flatten().collect();
+        let mut volume = BrickVolume {
+            origin: self.origin,
+            dims: self.dims,
+            index_to_world: glam::DMat4::IDENTITY,
+            map: self.map.into(),
+            constants: constants.into(),
+            ranges: ranges.into(),
+            atlas,
+            levels: Vec::new(),
+            info,
+            finest_partition: Default::default(),
+        };
+        clock.lap("map settled");
+        let level0 = brick_bounds(&volume);
+        clock.lap("level-0 bounds");
+        volume.levels = build_pyramid(level0);
+        clock.lap("bounds pyramid");
+        Ok(volume)
+    }
+
+    /// Numbers the stored bricks in leaf order and closes the gaps the
+    /// constant leaves left in the atlas (and the u8 ranges): each stored
+    /// slot moves to its number, never later than where it is. Returns
+    /// how many are stored.
+    fn number_stored(&mut self) -> usize {
         let mut stored = 0u32;
         for s in self.states.iter_mut() {
             if *s & STORED != 0 {
@@ -282,8 +325,6 @@ impl Builder {
                 stored += 1;
             }
         }
-        // 2. Close the gaps the constant leaves left: each stored slot moves
-        //    to its number, never later than where it is.
         fn compact<T: Copy>(v: &mut Vec<T>, states: &[u32], per: usize, stored: usize) {
             for (i, &s) in states.iter().enumerate() {
                 let r = (s & INDEX) as usize;
@@ -303,9 +344,13 @@ impl Builder {
         if self.precision == Precision::U8 {
             compact(&mut self.ranges, &self.states, 1, n);
         }
-        clock.lap("atlas numbered and compacted");
-        // 3. Final map codes, constants numbered in map order: count per
-        //    chunk, then fill each chunk's part of the table, in parallel.
+        n
+    }
+
+    /// The map's final codes, with the constants numbered in map order
+    /// (`n` bricks stored): count per chunk, then fill each chunk's part
+    /// of the table, in parallel. Returns the constants' table.
+    fn settle_map(&mut self, n: usize) -> Result<Vec<f32>, BrickError> {
         const CHUNK: usize = 1 << 16;
         let (states, tiles) = (&self.states, &self.tile_values);
         let constant_of = |code: u32| -> Option<f32> {
@@ -365,39 +410,7 @@ impl Builder {
                     };
                 }
             });
-        let count = self.map.len() as u64;
-        let mut info = self.info;
-        info.max_error = f32::from_bits(self.stats.max_error_bits.load(Ordering::Relaxed));
-        info.sanitized_voxels += self.stats.sanitized.load(Ordering::Relaxed);
-        info.bricks_stored = n as u64;
-        info.bricks_constant = total as u64;
-        info.bricks_empty = count - n as u64 - total as u64;
-        drop(self.states);
-        drop(self.tile_values);
-        let atlas = match self.atlas {
-            AtlasBuf::F32(v) => Atlas::F32(v.into()),
-            AtlasBuf::F16(v) => Atlas::F16(v.into()),
-            AtlasBuf::U8(v) => Atlas::U8(v.into()),
-        };
-        let ranges: Vec<f32> = self.ranges.into_iter().flatten().collect();
-        let mut volume = BrickVolume {
-            origin: self.origin,
-            dims: self.dims,
-            index_to_world: glam::DMat4::IDENTITY,
-            map: self.map.into(),
-            constants: constants.into(),
-            ranges: ranges.into(),
-            atlas,
-            levels: Vec::new(),
-            info,
-            finest_partition: Default::default(),
-        };
-        clock.lap("map settled");
-        let level0 = brick_bounds(&volume);
-        clock.lap("level-0 bounds");
-        volume.levels = build_pyramid(level0);
-        clock.lap("bounds pyramid");
-        Ok(volume)
+        Ok(constants)
     }
 }
 
