@@ -427,96 +427,156 @@ fn skip_leaf<V: Value>(cur: &mut ByteCursor, ctx: &StreamContext<V>) -> KindResu
     read_compressed_values::<V, 8>(cur, ctx, &mask, None, &mut Vec::new())
 }
 
+/// How many of the next `remaining` leaf records fit whole in `buf` (at
+/// file offset `pos`), and the bytes they take; a record cut off by the
+/// window's end is left for the next window where the file goes on
+/// (`more`), and is an error where it does not.
+fn fitting_leaves<V: Value>(
+    buf: &[u8],
+    pos: u64,
+    ctx: &StreamContext<V>,
+    remaining: usize,
+    more: bool,
+) -> KindResult<(usize, usize)> {
+    let mut cur = ByteCursor::new(buf, pos);
+    let (mut count, mut used) = (0usize, 0usize);
+    while count < remaining {
+        match skip_leaf(&mut cur, ctx) {
+            Ok(()) => {
+                count += 1;
+                used = cur.position();
+            }
+            Err(ErrorKind::Truncated { .. }) if more => break,
+            Err(kind) => return Err(kind),
+        }
+    }
+    Ok((count, used))
+}
+
+/// The first error of a parallel decode, and whether one happened (the
+/// other tasks stop at their next chunk).
+struct FirstFailure<E> {
+    stop: AtomicBool,
+    failure: Mutex<Option<E>>,
+}
+
+impl<E> Default for FirstFailure<E> {
+    fn default() -> Self {
+        Self {
+            stop: AtomicBool::new(false),
+            failure: Mutex::new(None),
+        }
+    }
+}
+
+impl<E> FirstFailure<E> {
+    fn record(&self, e: E) {
+        self.stop.store(true, Ordering::Relaxed);
+        let mut f = self.failure.lock().unwrap_or_else(|e| e.into_inner());
+        if f.is_none() {
+            *f = Some(e);
+        }
+    }
+
+    fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+
+    fn into_inner(self) -> Option<E> {
+        self.failure.into_inner().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// What stopped a chunk's decode: its bytes, or the sink.
+enum ChunkError<E> {
+    File(ErrorKind),
+    Sink(E),
+}
+
+/// Decodes the leaf records of `chunk` (at file offset `base`), leaves
+/// `leaves` of the topology, checking each value mask against the
+/// topology's fingerprint, and hands each leaf to `part`.
+fn decode_chunk<V: Value, S: LeafSink<V>>(
+    chunk: &[u8],
+    base: u64,
+    leaves: std::ops::Range<usize>,
+    hashes: &[u32],
+    ctx: &StreamContext<V>,
+    part: &mut S,
+) -> Result<(), ChunkError<S::Error>> {
+    let mut cur = ByteCursor::new(chunk, base);
+    let mut values = Box::new([ctx.background; 512]);
+    let mut scratch = Vec::new();
+    for (index, &hash) in leaves.clone().zip(&hashes[leaves]) {
+        let mask =
+            BitMask::<8>::from_le_bytes(cur.take(64, "leaf value mask").map_err(ChunkError::File)?);
+        if mask_hash(&mask) != hash {
+            return Err(ChunkError::File(corrupt(format!(
+                "leaf {index}'s value mask in the buffers differs from the topology's"
+            ))));
+        }
+        read_compressed_values(&mut cur, ctx, &mask, Some(&mut values[..]), &mut scratch)
+            .map_err(ChunkError::File)?;
+        part.leaf(index, &mask, &values).map_err(ChunkError::Sink)?;
+    }
+    Ok(())
+}
+
 impl<'f, V: Value> GridStream<'f, V> {
     pub fn path(&self) -> &std::path::Path {
         self.src.path()
     }
 
+    /// The window of leaf buffers from `pos`: [`WINDOW`] bytes, or what
+    /// is left of them.
+    fn window_at(&self, pos: u64) -> KindResult<Vec<u8>> {
+        let len = WINDOW.min(self.end.saturating_sub(pos));
+        self.src.read_at(pos, len, "leaf buffers")
+    }
+
     /// Decodes every leaf buffer and hands the leaves to `sink`, in chunks
     /// of about 4 MiB of file decoded in parallel (rayon). Reads the buffers
     /// once, in order; holds at most `2 x threads + 1` chunks at a time.
-    pub fn decode_leaves<S: LeafSink<V>>(self, sink: S) -> Result<(), DecodeError<S::Error>> {
+    pub fn decode_leaves<S: LeafSink<V>>(mut self, sink: S) -> Result<(), DecodeError<S::Error>> {
         let path = self.src.path();
         let file_err = |kind| DecodeError::File(Error::new(path, kind));
         let n_leaves = self.hashes.len();
         let limit = 2 * rayon::current_num_threads();
         let in_flight = AtomicUsize::new(0);
-        let stop = AtomicBool::new(false);
-        let failure: Mutex<Option<DecodeError<S::Error>>> = Mutex::new(None);
-        let fail = |e: DecodeError<S::Error>| {
-            stop.store(true, Ordering::Relaxed);
-            let mut f = failure.lock().unwrap_or_else(|e| e.into_inner());
-            if f.is_none() {
-                *f = Some(e);
-            }
-        };
+        let failure = FirstFailure::default();
+        let fail = |e| failure.record(e);
         let (hashes, ctx) = (&self.hashes, &self.ctx);
         let decode = |chunk: &[u8], base: u64, first: usize, count: usize, mut part: S| {
-            if stop.load(Ordering::Relaxed) {
+            if failure.stopped() {
                 return;
             }
-            let mut cur = ByteCursor::new(chunk, base);
-            let mut values = Box::new([ctx.background; 512]);
-            let mut scratch = Vec::new();
-            for (index, &hash) in (first..).zip(&hashes[first..first + count]) {
-                let step = (|| {
-                    let mask = BitMask::<8>::from_le_bytes(cur.take(64, "leaf value mask")?);
-                    if mask_hash(&mask) != hash {
-                        return Err(corrupt(format!(
-                            "leaf {index}'s value mask in the buffers differs from the topology's"
-                        )));
-                    }
-                    read_compressed_values(
-                        &mut cur,
-                        ctx,
-                        &mask,
-                        Some(&mut values[..]),
-                        &mut scratch,
-                    )?;
-                    Ok(mask)
-                })();
-                match step {
-                    Ok(mask) => {
-                        if let Err(e) = part.leaf(index, &mask, &values) {
-                            return fail(DecodeError::Sink(e));
-                        }
-                    }
-                    Err(kind) => return fail(file_err(kind)),
-                }
+            let leaves = first..first + count;
+            match decode_chunk(chunk, base, leaves, hashes, ctx, &mut part) {
+                Ok(()) => part.finish(),
+                Err(ChunkError::File(kind)) => fail(file_err(kind)),
+                Err(ChunkError::Sink(e)) => fail(DecodeError::Sink(e)),
             }
-            part.finish();
         };
         let mut next = 0usize;
         let mut pos = self.rest_pos;
-        let mut pending = Some(self.rest);
+        let mut pending = Some(std::mem::take(&mut self.rest));
         rayon::scope(|s| {
             let mut rest = sink;
-            while next < n_leaves && !stop.load(Ordering::Relaxed) {
+            while next < n_leaves && !failure.stopped() {
                 let buf = match pending.take().filter(|b| !b.is_empty()) {
                     Some(b) => b,
-                    None => {
-                        let len = WINDOW.min(self.end.saturating_sub(pos));
-                        match self.src.read_at(pos, len, "leaf buffers") {
-                            Ok(b) => b,
-                            Err(kind) => return fail(file_err(kind)),
-                        }
-                    }
+                    None => match self.window_at(pos) {
+                        Ok(b) => b,
+                        Err(kind) => return fail(file_err(kind)),
+                    },
                 };
                 let window_end = pos + buf.len() as u64;
                 let full = buf.len() as u64 >= WINDOW || window_end >= self.end;
-                // Count the leaf records that fit whole in this window.
-                let mut cur = ByteCursor::new(&buf, pos);
-                let (mut count, mut used) = (0usize, 0usize);
-                while next + count < n_leaves {
-                    match skip_leaf(&mut cur, ctx) {
-                        Ok(()) => {
-                            count += 1;
-                            used = cur.position();
-                        }
-                        Err(ErrorKind::Truncated { .. }) if window_end < self.end => break,
-                        Err(kind) => return fail(file_err(kind)),
-                    }
-                }
+                let more = window_end < self.end;
+                let (count, used) = match fitting_leaves(&buf, pos, ctx, n_leaves - next, more) {
+                    Ok(fit) => fit,
+                    Err(kind) => return fail(file_err(kind)),
+                };
                 if count == 0 && !full {
                     // A short piece left from the topology's window: read a whole window.
                     continue;
@@ -548,7 +608,7 @@ impl<'f, V: Value> GridStream<'f, V> {
                 }
             }
         });
-        if let Some(e) = failure.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        if let Some(e) = failure.into_inner() {
             return Err(e);
         }
         if next < n_leaves {
