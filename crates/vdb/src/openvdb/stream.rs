@@ -189,6 +189,47 @@ impl<V: Value> TopologyBuilder<V> {
         self.topo.leaf_origins.push(origin);
         self.hashes.push(mask_hash(mask));
     }
+
+    /// Reads the upper internal node at `origin` with its lower nodes and
+    /// their leaves' value masks, adding their tiles and leaves.
+    fn upper(
+        &mut self,
+        win: &mut Window,
+        origin: Coord,
+        c: &StreamContext<V>,
+        scratch: &mut Vec<u8>,
+    ) -> KindResult<()> {
+        let (child, value, tiles) = win.record(|cur| internal::<V, 512>(cur, c, scratch))?;
+        self.topo.node_counts.upper += 1;
+        for n in value.iter_on() {
+            let o = slot_origin(origin, n, 5, LOWER_TOTAL);
+            self.tile(o, LOWER_TOTAL, tiles[n], Level::Upper);
+        }
+        drop(tiles);
+        let slots: Vec<usize> = child.iter_on().collect();
+        win.ensure(slots.len() as u64, 2 * 512, "lower nodes")?;
+        for n in slots {
+            let lower_origin = slot_origin(origin, n, 5, LOWER_TOTAL);
+            let (lchild, lvalue, ltiles, masks) = win.record(|cur| {
+                let (child, value, tiles) = internal::<V, 64>(cur, c, scratch)?;
+                let count = child.count_on() as u64;
+                cur.ensure(count, 64, "leaf masks")?;
+                let masks: Vec<BitMask<8>> = (0..count)
+                    .map(|_| cur.take(64, "leaf value mask").map(BitMask::from_le_bytes))
+                    .collect::<KindResult<_>>()?;
+                Ok((child, value, tiles, masks))
+            })?;
+            self.topo.node_counts.lower += 1;
+            for k in lvalue.iter_on() {
+                let o = slot_origin(lower_origin, k, 4, LEAF_TOTAL);
+                self.tile(o, LEAF_TOTAL, ltiles[k], Level::Lower);
+            }
+            for (k, mask) in lchild.iter_on().zip(&masks) {
+                self.leaf(slot_origin(lower_origin, k, 4, LEAF_TOTAL), mask);
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Reads the topology (`Tree::readTopology`) at the window's position.
@@ -260,39 +301,7 @@ fn read_topology<V: Value>(
             )));
         }
         root_entry(origin)?;
-        let (child, value, tiles) = win.record(|cur| internal::<V, 512>(cur, &c, &mut scratch))?;
-        b.topo.node_counts.upper += 1;
-        for n in value.iter_on() {
-            b.tile(
-                slot_origin(origin, n, 5, LOWER_TOTAL),
-                LOWER_TOTAL,
-                tiles[n],
-                Level::Upper,
-            );
-        }
-        drop(tiles);
-        let slots: Vec<usize> = child.iter_on().collect();
-        win.ensure(slots.len() as u64, 2 * 512, "lower nodes")?;
-        for n in slots {
-            let lower_origin = slot_origin(origin, n, 5, LOWER_TOTAL);
-            let (lchild, lvalue, ltiles, masks) = win.record(|cur| {
-                let (child, value, tiles) = internal::<V, 64>(cur, &c, &mut scratch)?;
-                let count = child.count_on() as u64;
-                cur.ensure(count, 64, "leaf masks")?;
-                let masks: Vec<BitMask<8>> = (0..count)
-                    .map(|_| cur.take(64, "leaf value mask").map(BitMask::from_le_bytes))
-                    .collect::<KindResult<_>>()?;
-                Ok((child, value, tiles, masks))
-            })?;
-            b.topo.node_counts.lower += 1;
-            for k in lvalue.iter_on() {
-                let o = slot_origin(lower_origin, k, 4, LEAF_TOTAL);
-                b.tile(o, LEAF_TOTAL, ltiles[k], Level::Lower);
-            }
-            for (k, mask) in lchild.iter_on().zip(&masks) {
-                b.leaf(slot_origin(lower_origin, k, 4, LEAF_TOTAL), mask);
-            }
-        }
+        b.upper(win, origin, &c, &mut scratch)?;
     }
     b.topo.node_counts.root_entries = num_tiles as u64 + num_children as u64;
     b.topo.node_counts.leaves = b.topo.leaf_origins.len() as u64;
