@@ -106,6 +106,60 @@ fn inflate(src: &[u8], out: &mut [u8]) -> KindResult<()> {
     Ok(())
 }
 
+/// What precedes a node's values: the mode byte, the inactive values it
+/// implies (read or from the background) and the selection mask between
+/// them where it has one.
+struct NodeMode<V, const W: usize> {
+    meta: u8,
+    inactive: [V; 2],
+    selection: Option<BitMask<W>>,
+}
+
+impl<V: Value, const W: usize> NodeMode<V, W> {
+    fn read(cur: &mut ByteCursor, bg: V) -> KindResult<Self> {
+        let meta = cur.u8("node value mode")?;
+        if meta > mode::NO_MASK_AND_ALL_VALS {
+            return Err(corrupt(format!(
+                "node value mode {meta} is not one of the 7 OpenVDB writes"
+            )));
+        }
+        let mut inactive0 = if meta == mode::NO_MASK_OR_INACTIVE_VALS {
+            bg
+        } else {
+            bg.negate()
+        };
+        let mut inactive1 = bg;
+        if matches!(
+            meta,
+            mode::NO_MASK_AND_ONE_INACTIVE_VAL
+                | mode::MASK_AND_ONE_INACTIVE_VAL
+                | mode::MASK_AND_TWO_INACTIVE_VALS
+        ) {
+            inactive0 = V::from_le(cur.take(V::SIZE, "inactive value")?);
+            if meta == mode::MASK_AND_TWO_INACTIVE_VALS {
+                inactive1 = V::from_le(cur.take(V::SIZE, "inactive value")?);
+            }
+        }
+        let selection = if matches!(
+            meta,
+            mode::MASK_AND_NO_INACTIVE_VALS
+                | mode::MASK_AND_ONE_INACTIVE_VAL
+                | mode::MASK_AND_TWO_INACTIVE_VALS
+        ) {
+            Some(BitMask::<W>::from_le_bytes(
+                cur.take(BitMask::<W>::BYTES, "selection mask")?,
+            ))
+        } else {
+            None
+        };
+        Ok(Self {
+            meta,
+            inactive: [inactive0, inactive1],
+            selection,
+        })
+    }
+}
+
 /// Reads a node's values as `readCompressedValues` stores them: the mode
 /// byte, inactive values, the selection mask, then the values themselves —
 /// all of them, or with active-mask compression only the active ones, the
@@ -122,42 +176,11 @@ pub fn read_compressed_values<V: Value, const W: usize>(
     scratch: &mut Vec<u8>,
 ) -> KindResult<()> {
     let mask_compressed = ctx.compression & COMPRESS_ACTIVE_MASK != 0;
-    let meta = cur.u8("node value mode")?;
-    if meta > mode::NO_MASK_AND_ALL_VALS {
-        return Err(corrupt(format!(
-            "node value mode {meta} is not one of the 7 OpenVDB writes"
-        )));
-    }
-    let bg = ctx.background;
-    let mut inactive0 = if meta == mode::NO_MASK_OR_INACTIVE_VALS {
-        bg
-    } else {
-        bg.negate()
-    };
-    let mut inactive1 = bg;
-    if matches!(
+    let NodeMode {
         meta,
-        mode::NO_MASK_AND_ONE_INACTIVE_VAL
-            | mode::MASK_AND_ONE_INACTIVE_VAL
-            | mode::MASK_AND_TWO_INACTIVE_VALS
-    ) {
-        inactive0 = V::from_le(cur.take(V::SIZE, "inactive value")?);
-        if meta == mode::MASK_AND_TWO_INACTIVE_VALS {
-            inactive1 = V::from_le(cur.take(V::SIZE, "inactive value")?);
-        }
-    }
-    let selection = if matches!(
-        meta,
-        mode::MASK_AND_NO_INACTIVE_VALS
-            | mode::MASK_AND_ONE_INACTIVE_VAL
-            | mode::MASK_AND_TWO_INACTIVE_VALS
-    ) {
-        Some(BitMask::<W>::from_le_bytes(
-            cur.take(BitMask::<W>::BYTES, "selection mask")?,
-        ))
-    } else {
-        None
-    };
+        inactive: [inactive0, inactive1],
+        selection,
+    } = NodeMode::<V, W>::read(cur, ctx.background)?;
     let total = BitMask::<W>::BITS;
     let stored = if mask_compressed && meta != mode::NO_MASK_AND_ALL_VALS {
         value_mask.count_on() as usize
