@@ -267,49 +267,15 @@ impl Denoiser {
             }
         };
 
-        let ran = (|| {
-            let mut images: Vec<(&CStr, &mut [f32])> = vec![(c"color", &mut color)];
-            if let Some(a) = albedo.as_mut() {
-                images.push((c"albedo", a));
-            }
-            if let Some(n) = normal.as_mut() {
-                images.push((c"normal", n));
-            }
-            images.push((c"output", &mut output));
-            for (name, data) in images {
-                debug_assert_eq!(data.len(), len);
-                // SAFETY: `filter` is a live handle (cached, released only
-                // under this lock); `data` holds exactly width*height*3 f32
-                // (checked above, byte size checked not to overflow in
-                // `image_len`), matching FLOAT3 with packed strides (0 = auto);
-                // it outlives the execute below and the filter is never
-                // executed again without these images being set anew. The
-                // signature is oidnSetSharedFilterImage's in oidn.h 2.x.
-                unsafe {
-                    (self.api.set_shared_filter_image)(
-                        filter,
-                        name.as_ptr(),
-                        data.as_mut_ptr().cast(),
-                        ffi::FORMAT_FLOAT3,
-                        width,
-                        height,
-                        0,
-                        0,
-                        0,
-                    )
-                };
-                self.check("oidnSetSharedFilterImage")?;
-            }
-            // SAFETY: live filter with all its images set to buffers that are
-            // alive; signature of oidnCommitFilter in oidn.h 2.x.
-            unsafe { (self.api.commit_filter)(filter) };
-            self.check("oidnCommitFilter")?;
-            // SAFETY: as above; oidnExecuteFilter is synchronous, so OIDN is
-            // done with the buffers when it returns.
-            unsafe { (self.api.execute_filter)(filter) };
-            self.check("oidnExecuteFilter")
-        })();
-        if let Err(e) = ran {
+        let mut images: Vec<(&CStr, &mut [f32])> = vec![(c"color", &mut color)];
+        if let Some(a) = albedo.as_mut() {
+            images.push((c"albedo", a));
+        }
+        if let Some(n) = normal.as_mut() {
+            images.push((c"normal", n));
+        }
+        images.push((c"output", &mut output));
+        if let Err(e) = self.run_filter(filter, images, width, height) {
             // Do not keep a filter whose state is unknown.
             if let Some(old) = cache.take() {
                 self.release_filter(old.filter);
@@ -324,6 +290,57 @@ impl Denoiser {
             }
         }
         Ok(output)
+    }
+
+    /// Sets `images` (each `width * height` RGB `f32`, by OIDN name) on
+    /// `filter`, commits and executes it; the caller holds the filter
+    /// cache's lock.
+    fn run_filter(
+        &self,
+        filter: ffi::Filter,
+        images: Vec<(&CStr, &mut [f32])>,
+        width: usize,
+        height: usize,
+    ) -> Result<(), DenoiseError> {
+        let len = image_len(width, height)?;
+        for (name, data) in images {
+            if data.len() != len {
+                return Err(DenoiseError::InvalidInput(format!(
+                    "{name:?} holds {} values, not {len}",
+                    data.len()
+                )));
+            }
+            // SAFETY: `filter` is a live handle (cached, released only
+            // under the cache's lock, which the caller holds); `data` holds
+            // exactly width*height*3 f32 (checked just above, its byte size
+            // checked not to overflow in `image_len`), matching FLOAT3 with
+            // packed strides (0 = auto);
+            // it outlives the execute below and the filter is never
+            // executed again without these images being set anew. The
+            // signature is oidnSetSharedFilterImage's in oidn.h 2.x.
+            unsafe {
+                (self.api.set_shared_filter_image)(
+                    filter,
+                    name.as_ptr(),
+                    data.as_mut_ptr().cast(),
+                    ffi::FORMAT_FLOAT3,
+                    width,
+                    height,
+                    0,
+                    0,
+                    0,
+                )
+            };
+            self.check("oidnSetSharedFilterImage")?;
+        }
+        // SAFETY: live filter with all its images set to buffers that are
+        // alive; signature of oidnCommitFilter in oidn.h 2.x.
+        unsafe { (self.api.commit_filter)(filter) };
+        self.check("oidnCommitFilter")?;
+        // SAFETY: as above; oidnExecuteFilter is synchronous, so OIDN is
+        // done with the buffers when it returns.
+        unsafe { (self.api.execute_filter)(filter) };
+        self.check("oidnExecuteFilter")
     }
 
     /// A new committed-later "RT" filter with `hdr` set and `cleanAux` off.
