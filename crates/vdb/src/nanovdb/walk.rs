@@ -139,6 +139,32 @@ const LEVEL_NAMES: [(&str, &str); 3] = [
     ("upper node", "upper nodes"),
 ];
 
+/// The node counts the tree declares per level (leaves, lower, upper),
+/// checked to fit in the buffer: this bounds every allocation of the walk.
+fn declared_nodes(b: Buf<'_>, lay: &Layout) -> KindResult<[u64; 3]> {
+    let tree_at = layout::GRID_DATA_SIZE;
+    let mut declared = [0u64; 3];
+    for (level, d) in declared.iter_mut().enumerate() {
+        *d = b.u32(tree_at + layout::tree::NODE_COUNT + 4 * level, "node count")? as u64;
+    }
+    let sizes = [lay.min_leaf_size(), lay.lower_size(), lay.upper_size()];
+    let needed: u128 = declared
+        .iter()
+        .zip(sizes)
+        .map(|(&n, s)| n as u128 * s as u128)
+        .sum();
+    if needed > b.0.len() as u128 {
+        return Err(corrupt(format!(
+            "tree declares {} leaves, {} lower and {} upper nodes: more than its {}-byte buffer holds",
+            declared[0],
+            declared[1],
+            declared[2],
+            b.0.len()
+        )));
+    }
+    Ok(declared)
+}
+
 impl<'a, V: Value> Walk<'a, V> {
     fn run(
         b: Buf<'a>,
@@ -147,26 +173,7 @@ impl<'a, V: Value> Walk<'a, V> {
         leaf_values: impl Fn(&[u8], &mut [V; 512]) + Sync,
     ) -> KindResult<Tree<V>> {
         let tree_at = layout::GRID_DATA_SIZE;
-        let mut declared = [0u64; 3];
-        for (level, d) in declared.iter_mut().enumerate() {
-            *d = b.u32(tree_at + layout::tree::NODE_COUNT + 4 * level, "node count")? as u64;
-        }
-        // The declared nodes must fit in the buffer: this bounds every allocation below.
-        let sizes = [lay.min_leaf_size(), lay.lower_size(), lay.upper_size()];
-        let needed: u128 = declared
-            .iter()
-            .zip(sizes)
-            .map(|(&n, s)| n as u128 * s as u128)
-            .sum();
-        if needed > b.0.len() as u128 {
-            return Err(corrupt(format!(
-                "tree declares {} leaves, {} lower and {} upper nodes: more than its {}-byte buffer holds",
-                declared[0],
-                declared[1],
-                declared[2],
-                b.0.len()
-            )));
-        }
+        let declared = declared_nodes(b, lay)?;
         let root_rel = b.u64(tree_at + layout::tree::NODE_OFFSET + 24, "root offset")?;
         let root = usize::try_from(root_rel)
             .ok()
@@ -210,8 +217,19 @@ impl<'a, V: Value> Walk<'a, V> {
             };
             tree.insert_root(origin, slot)?;
         }
-        let decoded: Vec<LeafNode<V>> = walk
-            .leaves
+        for leaf in walk.decoded_leaves(leaf_values) {
+            tree.push_leaf(leaf);
+        }
+        Ok(tree)
+    }
+
+    /// The leaves the walk found, their values decoded in parallel.
+    fn decoded_leaves(
+        &self,
+        leaf_values: impl Fn(&[u8], &mut [V; 512]) + Sync,
+    ) -> Vec<LeafNode<V>> {
+        let b = self.b;
+        self.leaves
             .par_iter()
             .map(|&(off, size, origin)| {
                 let leaf = &b.0[off..off + size];
@@ -225,11 +243,7 @@ impl<'a, V: Value> Walk<'a, V> {
                     values,
                 }
             })
-            .collect();
-        for leaf in decoded {
-            tree.push_leaf(leaf);
-        }
-        Ok(tree)
+            .collect()
     }
 
     /// Resolves a child offset relative to `base`, checks the node lies in
