@@ -246,6 +246,102 @@ fn read_exr_rgba(path: &Path) -> Result<RgbaImage, Box<dyn std::error::Error>> {
     ))
 }
 
+/// The scene again, loaded through `cache`, its fields walked through a
+/// fixed grid of `res` cells a side (the uniform-grid baseline).
+fn fixed_grid_scene<'c>(
+    file: &SceneFile,
+    res: i32,
+    cache: &'c mut VolumeCache,
+) -> Result<Scene<Volumes<FixedGridField<'c>>>, Box<dyn std::error::Error>> {
+    let p = file.prepare(cache, None)?;
+    let fixed: Vec<Medium<FixedGridField>> = p
+        .scene
+        .media
+        .into_instances()
+        .into_iter()
+        .map(|m| Medium {
+            field: FixedGridField::new(m.field.into_still(), res),
+            density_scale: m.density_scale,
+            extinction_tint: m.extinction_tint,
+            albedo: m.albedo,
+            phase: m.phase,
+            emission: None,
+            holdout: m.holdout,
+        })
+        .collect();
+    Ok(Scene {
+        media: Volumes::new(fixed),
+        camera: p.scene.camera,
+        lights: p.scene.lights,
+    })
+}
+
+impl Row {
+    /// The row of `config` at `budget` seconds: render `r`'s error against
+    /// `reference` and its work.
+    fn of(config: &str, budget: f64, r: &cirrus_render::Rendered, reference: &[[f32; 4]]) -> Self {
+        let (mse, rel_mse) = errors(&r.image.rgba, reference);
+        let s = &r.stats;
+        let per_path = |n: u64| n as f64 / s.counters.paths.max(1) as f64;
+        Row {
+            config: config.to_string(),
+            budget,
+            // The denoiser's time is part of the image's cost.
+            wall: s.wall_seconds + s.denoise_seconds,
+            spp: s.spp,
+            mse,
+            rel_mse,
+            paths_per_s: s.rays_per_second,
+            lookups_per_path: per_path(s.counters.density_lookups),
+            null_per_real: s.counters.null_collisions as f64
+                / s.counters.real_collisions.max(1) as f64,
+            real_per_path: per_path(s.counters.real_collisions),
+        }
+    }
+}
+
+/// A reference image from `path`, which must be `w` x `h`.
+fn read_reference(
+    path: &Path,
+    w: u32,
+    h: u32,
+) -> Result<Vec<[f32; 4]>, Box<dyn std::error::Error>> {
+    let (rw, rh, px) = read_exr_rgba(path)?;
+    if (rw, rh) != (w as usize, h as usize) {
+        return Err(format!(
+            "{}: reference is {rw}x{rh}, the scene is {w}x{h}",
+            path.display()
+        )
+        .into());
+    }
+    Ok(px)
+}
+
+impl Config {
+    /// The render settings of this configuration over `base`.
+    fn settings(&self, budget: Budget, seed: u64, base: &RenderSettings) -> RenderSettings {
+        RenderSettings {
+            integrator: self.integrator,
+            transmittance: self.transmittance,
+            majorant: match self.structure {
+                Structure::Global => MajorantMode::Global,
+                Structure::Auto => MajorantMode::Auto,
+                Structure::Hierarchy | Structure::Fixed => MajorantMode::Hierarchy,
+            },
+            budget,
+            seed,
+            step_voxels: self.step,
+            sampler: self.sampler,
+            adaptive: self.adaptive,
+            aovs: self.denoise,
+            light_sampling: self.light_sampling,
+            sunward: self.sunward,
+            progress: false,
+            ..base.clone()
+        }
+    }
+}
+
 pub fn run(args: &ErrorArgs) -> BenchResult {
     std::fs::create_dir_all(&args.out)?;
     let mut file = SceneFile::load(&args.scene.file)?;
@@ -254,50 +350,9 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
     let prepared = file.prepare(&mut cache, None)?;
     let (scene, base) = (&prepared.scene, &prepared.settings);
     let (w, h) = (scene.camera.width(), scene.camera.height());
-    // The same scene again, its fields walked through the fixed grid.
     let mut fixed_cache = VolumeCache::default();
-    let fixed_scene = {
-        let p = file.prepare(&mut fixed_cache, None)?;
-        let fixed: Vec<Medium<FixedGridField>> = p
-            .scene
-            .media
-            .into_instances()
-            .into_iter()
-            .map(|m| Medium {
-                field: FixedGridField::new(m.field.into_still(), args.fixed_res),
-                density_scale: m.density_scale,
-                extinction_tint: m.extinction_tint,
-                albedo: m.albedo,
-                phase: m.phase,
-                emission: None,
-                holdout: m.holdout,
-            })
-            .collect();
-        Scene {
-            media: Volumes::new(fixed),
-            camera: p.scene.camera,
-            lights: p.scene.lights,
-        }
-    };
-    let settings_for = |c: &Config, budget: Budget, seed: u64| RenderSettings {
-        integrator: c.integrator,
-        transmittance: c.transmittance,
-        majorant: match c.structure {
-            Structure::Global => MajorantMode::Global,
-            Structure::Auto => MajorantMode::Auto,
-            Structure::Hierarchy | Structure::Fixed => MajorantMode::Hierarchy,
-        },
-        budget,
-        seed,
-        step_voxels: c.step,
-        sampler: c.sampler,
-        adaptive: c.adaptive,
-        aovs: c.denoise,
-        light_sampling: c.light_sampling,
-        sunward: c.sunward,
-        progress: false,
-        ..base.clone()
-    };
+    let fixed_scene = fixed_grid_scene(&file, args.fixed_res, &mut fixed_cache)?;
+    let settings_for = |c: &Config, budget: Budget, seed: u64| c.settings(budget, seed, base);
     let render_with = |c: &Config, s: &RenderSettings| {
         if c.structure == Structure::Fixed {
             render(&fixed_scene, s)
@@ -307,17 +362,7 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
     };
 
     let reference = match &args.reference {
-        Some(path) => {
-            let (rw, rh, px) = read_exr_rgba(path)?;
-            if (rw, rh) != (w as usize, h as usize) {
-                return Err(format!(
-                    "{}: reference is {rw}x{rh}, the scene is {w}x{h}",
-                    path.display()
-                )
-                .into());
-            }
-            px
-        }
+        Some(path) => read_reference(path, w, h)?,
         None => {
             let c = Config::path(
                 "reference".into(),
@@ -349,23 +394,7 @@ pub fn run(args: &ErrorArgs) -> BenchResult {
             if c.denoise {
                 cirrus_scene::denoise(&mut r)?;
             }
-            let (mse, rel_mse) = errors(&r.image.rgba, &reference);
-            let s = &r.stats;
-            let row = Row {
-                config: c.name.clone(),
-                budget: b,
-                // The denoiser's time is part of the image's cost.
-                wall: s.wall_seconds + s.denoise_seconds,
-                spp: s.spp,
-                mse,
-                rel_mse,
-                paths_per_s: s.rays_per_second,
-                lookups_per_path: s.counters.density_lookups as f64
-                    / s.counters.paths.max(1) as f64,
-                null_per_real: s.counters.null_collisions as f64
-                    / s.counters.real_collisions.max(1) as f64,
-                real_per_path: s.counters.real_collisions as f64 / s.counters.paths.max(1) as f64,
-            };
+            let row = Row::of(&c.name, b, &r, &reference);
             eprintln!(
                 "{:<34} {:>5.2} s: {:>5} spp, RMSE {:.5}, relMSE {:.5}",
                 row.config,
