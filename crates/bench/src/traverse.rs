@@ -2,10 +2,10 @@
 //! same random rays, plus conversion speed and memory.
 
 use crate::baseline::{FixedMajorantGrid, GlobalMajorant};
-use crate::measure::{density_integral, measure, random_rays, TraversalReport};
+use crate::measure::{density_integral, measure, random_rays, LocalRay, TraversalReport};
 use crate::BenchResult;
-use cirrus_bricks::{convert, Precision};
-use cirrus_vdb::VolumeFile;
+use cirrus_bricks::{convert, BrickVolume, Precision};
+use cirrus_vdb::{Grid, VolumeFile};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -42,30 +42,7 @@ pub fn run(args: &TraverseArgs) -> BenchResult {
         load_s
     );
 
-    println!(
-        "\nconversion (rayon, {} threads):",
-        rayon::current_num_threads()
-    );
-    let mut volume = None;
-    for precision in [Precision::F32, Precision::F16, Precision::U8] {
-        let start = Instant::now();
-        let v = convert(&grid, precision)?;
-        let s = start.elapsed().as_secs_f64();
-        println!(
-            "  {:>3}: {:.3} s, {:.1} M active voxels/s, {} bytes = {:.3} x the reader's tree ({} bytes), max error {:e}",
-            precision.name(),
-            s,
-            v.info.active_voxels as f64 / s / 1e6,
-            v.total_bytes(),
-            v.total_bytes() as f64 / tree_bytes as f64,
-            tree_bytes,
-            v.info.max_error
-        );
-        if precision == Precision::F32 {
-            volume = Some(v);
-        }
-    }
-    let volume = volume.expect("converted above");
+    let volume = convert_each_precision(&grid, tree_bytes)?;
     if let Some(nvdb) = &args.nvdb {
         let len = std::fs::metadata(nvdb)?.len();
         println!(
@@ -102,11 +79,50 @@ pub fn run(args: &TraverseArgs) -> BenchResult {
         integrals.iter().filter(|&&d| d > 1e-6).count(),
         fixed_s
     );
+    print_traversals(&reports);
+    lookup_rate(&volume, &rays);
+    Ok(())
+}
+
+/// Converts `grid` at each precision, printing time, size against the
+/// reader's tree (`tree_bytes`) and error; returns the f32 volume.
+fn convert_each_precision(
+    grid: &Grid,
+    tree_bytes: usize,
+) -> Result<BrickVolume, Box<dyn std::error::Error>> {
+    println!(
+        "\nconversion (rayon, {} threads):",
+        rayon::current_num_threads()
+    );
+    let mut volume = None;
+    for precision in [Precision::F32, Precision::F16, Precision::U8] {
+        let start = Instant::now();
+        let v = convert(&grid, precision)?;
+        let s = start.elapsed().as_secs_f64();
+        println!(
+            "  {:>3}: {:.3} s, {:.1} M active voxels/s, {} bytes = {:.3} x the reader's tree ({} bytes), max error {:e}",
+            precision.name(),
+            s,
+            v.info.active_voxels as f64 / s / 1e6,
+            v.total_bytes(),
+            v.total_bytes() as f64 / tree_bytes as f64,
+            tree_bytes,
+            v.info.max_error
+        );
+        if precision == Precision::F32 {
+            volume = Some(v);
+        }
+    }
+    Ok(volume.expect("converted above"))
+}
+
+/// The traversal table: each structure against the global majorant (a).
+fn print_traversals(reports: &[TraversalReport]) {
     println!(
         "  {:<24} {:>13} {:>12} {:>14} {:>9} {:>16} {:>9}",
         "structure", "segments/ray", "rays/s", "tightness", "vs (a)", "pooled tightness", "vs (a)"
     );
-    for r in &reports {
+    for r in reports {
         println!(
             "  {:<24} {:>13.2} {:>12.0} {:>14.2} {:>8.1}x {:>16.3} {:>8.1}x",
             r.name,
@@ -122,7 +138,10 @@ pub fn run(args: &TraverseArgs) -> BenchResult {
         "  (tightness: mean over rays of integral(majorant) / integral(density), 1 is the limit;"
     );
     println!("   pooled: the ratio of the sums, which grazing rays do not dominate)");
-    // Density lookups: trilinear at points along the same rays.
+}
+
+/// Trilinear lookups per second on one thread, at points along `rays`.
+fn lookup_rate(volume: &BrickVolume, rays: &[LocalRay]) {
     let points: Vec<glam::Vec3> = rays
         .iter()
         .flat_map(|r| (0..16).map(move |k| r.origin + r.dir * (r.t_max * (k as f32 + 0.5) / 16.0)))
@@ -137,5 +156,4 @@ pub fn run(args: &TraverseArgs) -> BenchResult {
         "\ndensity lookups: {:.1} M trilinear lookups/s on one thread (checksum {sum:.3})",
         points.len() as f64 / s / 1e6
     );
-    Ok(())
 }
