@@ -97,7 +97,7 @@ fn convert_each_precision(
     let mut volume = None;
     for precision in [Precision::F32, Precision::F16, Precision::U8] {
         let start = Instant::now();
-        let v = convert(&grid, precision)?;
+        let v = convert(grid, precision)?;
         let s = start.elapsed().as_secs_f64();
         println!(
             "  {:>3}: {:.3} s, {:.1} M active voxels/s, {} bytes = {:.3} x the reader's tree ({} bytes), max error {:e}",
