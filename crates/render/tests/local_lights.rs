@@ -8,8 +8,9 @@
 //! - a spot light is the same integral times its cone's falloff;
 //!   (each with equi-angular sampling beside the free flight, and the
 //!   point light with free flights alone as well);
-//! - a small ball lights as the point of its intensity `L pi r^2`, and a
-//!   small rect or disk as the point of intensity `L A cos(theta)`;
+//! - a small ball lights as the point of its intensity `L pi r^2`, a
+//!   small rect or disk as the point of intensity `L A cos(theta)`, and a
+//!   small cylinder as the point of intensity `L 2 r l sin(theta)`;
 //! - a rect light seen by the camera shows its radiance times the
 //!   transmittance to it;
 //! - a ball seen by the camera shows its radiance times the transmittance
