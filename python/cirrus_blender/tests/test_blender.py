@@ -334,6 +334,32 @@ def test_each_lamp_alone_lights_a_box_of_fog_as_cycles_does(addon, tmp_path, kin
     assert_renders_as_cycles(addon, scene, tmp_path)
 
 
+def test_a_lamp_visible_to_the_camera_shows_its_ball_as_cycles_does(addon, tmp_path):
+    """A point lamp with a radius between the camera and a box of fog,
+    visible to the camera: the add-on passes the visibility, and both show
+    the ball at the lamp's radiance (and light the fog behind it)."""
+    import mathutils
+
+    scene, _ = build_scene(vdb=FOG, density_per_voxel=0.01)
+    scene.objects["Sun"].hide_render = True
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    obj = scene.objects["Cloud"]
+    corners = [obj.matrix_world @ mathutils.Vector(c) for c in obj.bound_box]
+    lo = mathutils.Vector([min(c[i] for c in corners) for i in range(3)])
+    hi = mathutils.Vector([max(c[i] for c in corners) for i in range(3)])
+    centre, size = 0.5 * (lo + hi), max(hi - lo)
+    camera = scene.camera.matrix_world.to_translation()
+    data = bpy.data.lights.new("Bulb", "POINT")
+    data.energy = 3.0 * 4.0 * math.pi * (0.3 * size) ** 2
+    data.shadow_soft_size = 0.05 * size
+    data.use_soft_falloff = False
+    lamp = bpy.data.objects.new("Bulb", data)
+    lamp.location = camera + 0.5 * (centre - camera) + size * mathutils.Vector((0.1, 0.05, 0.0))
+    lamp.visible_camera = True
+    scene.collection.objects.link(lamp)
+    assert_renders_as_cycles(addon, scene, tmp_path)
+
+
 def assert_renders_as_cycles(addon, scene, tmp_path) -> None:
     """Two Cycles and two cirrus renders of `scene` agree within noise on
     the cloud's mean and per block of 16x16 pixels."""
