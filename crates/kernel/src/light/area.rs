@@ -209,9 +209,10 @@ impl AreaLight {
         let r = p + t * dir - self.centre;
         let a = r.dot(self.half_u) / self.half_u.length_squared();
         let b = r.dot(self.half_v) / self.half_v.length_squared();
-        let inside = match self.shape {
-            AreaShape::Rect => a.abs() <= 1.0 && b.abs() <= 1.0,
-            AreaShape::Disk | AreaShape::Cylinder => a * a + b * b <= 1.0,
+        let inside = if self.shape == AreaShape::Rect {
+            a.abs() <= 1.0 && b.abs() <= 1.0
+        } else {
+            a * a + b * b <= 1.0
         };
         inside.then(|| {
             let pdf = match self.spherical_from(p) {
