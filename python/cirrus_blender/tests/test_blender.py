@@ -53,6 +53,25 @@ def voxel_size(vol) -> float:
     return math.sqrt(sum(m[r][0] ** 2 for r in range(3)))
 
 
+def cloud_box(obj):
+    """The centre (a Vector) and largest side of `obj`'s evaluated world
+    bounding box."""
+    import mathutils
+
+    bpy.context.view_layer.update()
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    corners = [obj.matrix_world @ mathutils.Vector(c) for c in evaluated.bound_box]
+    lo = mathutils.Vector([min(c[i] for c in corners) for i in range(3)])
+    hi = mathutils.Vector([max(c[i] for c in corners) for i in range(3)])
+    return 0.5 * (lo + hi), max(hi - lo)
+
+
+def lights_off(scene) -> None:
+    """The scene's sun hidden and its sky black."""
+    scene.objects["Sun"].hide_render = True
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+
+
 def look_at(eye, target):
     import mathutils
 
@@ -87,15 +106,7 @@ def build_scene(extra_mesh: bool = False, vdb: Path = CLOUD, density_per_voxel: 
     nt.links.new(pv.outputs["Volume"], out.inputs["Volume"])
     vol.materials.append(mat)
     # Camera and sun around the cloud's box (Blender is Z-up).
-    import mathutils
-
-    bpy.context.view_layer.update()
-    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    corners = [obj.matrix_world @ mathutils.Vector(c) for c in evaluated.bound_box]
-    lo = [min(c[i] for c in corners) for i in range(3)]
-    hi = [max(c[i] for c in corners) for i in range(3)]
-    centre = [(a + b) / 2 for a, b in zip(lo, hi)]
-    size = max(b - a for a, b in zip(lo, hi))
+    centre, size = cloud_box(obj)
     cam_data = bpy.data.cameras.new("Cam")
     cam_data.sensor_fit = "VERTICAL"
     cam_data.angle_y = math.radians(40.0)
@@ -198,16 +209,8 @@ def add_lamps(scene) -> None:
     exact ball Cycles then renders)."""
     import mathutils
 
-    scene.objects["Sun"].hide_render = True
-    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    obj = scene.objects["Cloud"]
-    bpy.context.view_layer.update()
-    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    corners = [obj.matrix_world @ mathutils.Vector(c) for c in evaluated.bound_box]
-    lo = [min(c[i] for c in corners) for i in range(3)]
-    hi = [max(c[i] for c in corners) for i in range(3)]
-    centre = mathutils.Vector([(a + b) / 2 for a, b in zip(lo, hi)])
-    size = max(b - a for a, b in zip(lo, hi))
+    lights_off(scene)
+    centre, size = cloud_box(scene.objects["Cloud"])
     for name, kind, offset, energy in (
         ("Bulb", "POINT", (0.6, -0.3, 0.1), 6.0),
         ("Beam", "SPOT", (0.0, 0.0, 0.9), 12.0),
@@ -241,12 +244,7 @@ def add_area_lamps(scene) -> None:
     turned to -X) and an ellipse above it facing down."""
     import mathutils
 
-    obj = scene.objects["Cloud"]
-    corners = [obj.matrix_world @ mathutils.Vector(c) for c in obj.bound_box]
-    lo = [min(c[i] for c in corners) for i in range(3)]
-    hi = [max(c[i] for c in corners) for i in range(3)]
-    centre = mathutils.Vector([(a + b) / 2 for a, b in zip(lo, hi)])
-    size = max(b - a for a, b in zip(lo, hi))
+    centre, size = cloud_box(scene.objects["Cloud"])
     for name, shape, offset, rotation in (
         ("Panel", "RECTANGLE", (0.7, -0.2, 0.0), (0.0, math.radians(90.0), 0.0)),
         ("Ceiling", "ELLIPSE", (0.0, 0.0, 0.7), (0.0, 0.0, math.radians(30.0))),
@@ -293,6 +291,15 @@ def test_every_lamp_kind_together_renders_as_cycles_does(addon, tmp_path):
 FOG = REPO / "data" / "tile_box.vdb"
 
 
+def fog_scene():
+    """A box of homogeneous fog (`tile_box.vdb`) with the sun and sky off,
+    its centre and largest side."""
+    scene, _ = build_scene(vdb=FOG, density_per_voxel=0.01)
+    lights_off(scene)
+    centre, size = cloud_box(scene.objects["Cloud"])
+    return scene, centre, size
+
+
 @pytest.mark.parametrize("kind", ["POINT", "SPOT", "AREA", "SUN"])
 def test_each_lamp_alone_lights_a_box_of_fog_as_cycles_does(addon, tmp_path, kind):
     """A box of homogeneous fog (`tile_box.vdb`, 0.64 mean free paths
@@ -303,14 +310,7 @@ def test_each_lamp_alone_lights_a_box_of_fog_as_cycles_does(addon, tmp_path, kin
     lamp of this size inside the fog agrees (z +3.1, BENCHMARKS.md)."""
     import mathutils
 
-    scene, _ = build_scene(vdb=FOG, density_per_voxel=0.01)
-    scene.objects["Sun"].hide_render = True
-    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    obj = scene.objects["Cloud"]
-    corners = [obj.matrix_world @ mathutils.Vector(c) for c in obj.bound_box]
-    lo = mathutils.Vector([min(c[i] for c in corners) for i in range(3)])
-    hi = mathutils.Vector([max(c[i] for c in corners) for i in range(3)])
-    centre, size = 0.5 * (lo + hi), max(hi - lo)
+    scene, centre, size = fog_scene()
     data = bpy.data.lights.new(kind.title(), kind)
     data.color = (1.0, 0.85, 0.7)
     if kind == "SUN":
@@ -340,14 +340,7 @@ def test_a_lamp_visible_to_the_camera_shows_its_ball_as_cycles_does(addon, tmp_p
     the ball at the lamp's radiance (and light the fog behind it)."""
     import mathutils
 
-    scene, _ = build_scene(vdb=FOG, density_per_voxel=0.01)
-    scene.objects["Sun"].hide_render = True
-    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    obj = scene.objects["Cloud"]
-    corners = [obj.matrix_world @ mathutils.Vector(c) for c in obj.bound_box]
-    lo = mathutils.Vector([min(c[i] for c in corners) for i in range(3)])
-    hi = mathutils.Vector([max(c[i] for c in corners) for i in range(3)])
-    centre, size = 0.5 * (lo + hi), max(hi - lo)
+    scene, centre, size = fog_scene()
     camera = scene.camera.matrix_world.to_translation()
     data = bpy.data.lights.new("Bulb", "POINT")
     data.energy = 3.0 * 4.0 * math.pi * (0.3 * size) ** 2
