@@ -225,13 +225,14 @@ impl SphereLight {
         }
         let to_centre = self.position - p;
         let d2 = to_centre.length_squared();
-        let l = self.radiance() * self.falloff(-dir);
-        let Some(one_minus_cos) = self.cone(d2) else {
-            let t = self.exit_distance(to_centre, dir);
-            return (t < t_max).then_some((t, l, UNIFORM_SPHERE_PDF));
+        let (t, pdf) = match self.cone(d2) {
+            Some(one_minus_cos) => (
+                self.hit_distance(to_centre, dir)?,
+                1.0 / (2.0 * PI * one_minus_cos),
+            ),
+            None => (self.exit_distance(to_centre, dir), UNIFORM_SPHERE_PDF),
         };
-        let t = self.hit_distance(to_centre, dir)?;
-        (t < t_max).then_some((t, l, 1.0 / (2.0 * PI * one_minus_cos)))
+        (t < t_max).then(|| (t, self.radiance() * self.falloff(-dir), pdf))
     }
 
     /// The near root of the ray from the ball's outside (`to_centre` from
