@@ -24,8 +24,8 @@ What is mapped:
   direction; its radius makes it a ball of that intensity) and spot lamps
   (the same, in a cone of half the spot size, its edge blended over
   `spot_blend` of the cone's `1 - cos`, as Cycles' smoothstep does), each
-  named by its object (its light-group layer; camera rays do not see a
-  lamp's surface, cirrus's default, whatever its ray visibility), and area lamps (square,
+  named by its object (its light-group layer; camera rays see a lamp's
+  surface where its object is visible to the camera), and area lamps (square,
   rectangle, disk, ellipse; Cycles' radiance `P c / (pi A)`, the size
   scaled by the object, emitting along -Z); Cycles' soft falloff (on by
   default) changes a lamp's light only near its surface, where cirrus's

@@ -101,10 +101,14 @@ impl<F: DensityField> Volumes<F> {
 }
 
 /// Segments of [`Volumes`]: one instance's own, or the merge of several.
+///
+/// The merge is boxed: it holds room for four instances' iterators, and a
+/// walk takes its segments by value, so unboxed every walk (most of which
+/// pass through one instance) would copy several hundred bytes.
 pub enum VolumeSegments<'a, F: DensityField + 'a> {
     None,
     One(Scaled<F::Segments<'a>>),
-    Many(Merged<F::Segments<'a>>),
+    Many(Box<Merged<F::Segments<'a>>>),
 }
 
 impl<'a, F: DensityField + 'a> Iterator for VolumeSegments<'a, F> {
@@ -142,9 +146,9 @@ impl<F: DensityField> Media for Volumes<F> {
                 match hits.len() {
                     0 => VolumeSegments::None,
                     1 => VolumeSegments::One(self.instance_segments(&hits[0], origin, dir)),
-                    _ => VolumeSegments::Many(Merged::new(
+                    _ => VolumeSegments::Many(Box::new(Merged::new(
                         hits.iter().map(|h| self.instance_segments(h, origin, dir)),
-                    )),
+                    ))),
                 }
             }
         }
