@@ -80,6 +80,8 @@ pub struct LightGrid {
     lo: Vec3,
     cell: f32,
     points: [usize; 3],
+    /// The highest stencil corner along each axis: `points - 2`, at least 0.
+    max_base: Vec3,
     bricks: [usize; 3],
     /// The kinds of the lights the grid was built for, in order.
     kinds: Vec<LightKind>,
@@ -118,6 +120,7 @@ impl LightGrid {
             lo,
             cell,
             points,
+            max_base: Vec3::from_array(points.map(|n| n.saturating_sub(2) as f32)),
             bricks,
             kinds,
             width,
@@ -330,16 +333,12 @@ impl LightGrid {
     /// corner and the fractions across it.
     #[inline]
     fn stencil(&self, p: Vec3) -> ([usize; 3], [f32; 3]) {
+        // In vector lanes, converted to u32 (one instruction each, where a
+        // float to usize takes a dozen): the lookup is on every vertex.
         let x = (p - self.lo) / self.cell;
-        let mut base = [0usize; 3];
-        let mut f = [0f32; 3];
-        for a in 0..3 {
-            let max_base = self.points[a].saturating_sub(2) as f32;
-            let xb = x[a].floor().clamp(0.0, max_base);
-            base[a] = xb as usize;
-            f[a] = (x[a] - xb).clamp(0.0, 1.0);
-        }
-        (base, f)
+        let xb = x.floor().clamp(Vec3::ZERO, self.max_base);
+        let f = (x - xb).clamp(Vec3::ZERO, Vec3::ONE);
+        (xb.as_uvec3().to_array().map(|b| b as usize), f.to_array())
     }
 
     /// Trilinear interpolation of the stored entries at `p` (clamped to
@@ -367,19 +366,15 @@ impl LightGrid {
         const Y: usize = STORED;
         const Z: usize = STORED * STORED;
         let corners = &brick[o * w..(o + Z + Y + 2) * w];
-        let corner = |d: usize, n: usize| corners[d * w + n];
+        // Each corner's slots as a slice of exactly `w`, so the loop below
+        // indexes them without bounds checks.
+        let at = |d: usize| &corners[d * w..d * w + w];
+        let [c0, c1, c2, c3] = [at(0), at(1), at(Y), at(Y + 1)];
+        let [c4, c5, c6, c7] = [at(Z), at(Z + 1), at(Z + Y), at(Z + Y + 1)];
         let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
         for n in 0..w {
-            let z0 = lerp(
-                lerp(corner(0, n), corner(1, n), f[0]),
-                lerp(corner(Y, n), corner(Y + 1, n), f[0]),
-                f[1],
-            );
-            let z1 = lerp(
-                lerp(corner(Z, n), corner(Z + 1, n), f[0]),
-                lerp(corner(Z + Y, n), corner(Z + Y + 1, n), f[0]),
-                f[1],
-            );
+            let z0 = lerp(lerp(c0[n], c1[n], f[0]), lerp(c2[n], c3[n], f[0]), f[1]);
+            let z1 = lerp(lerp(c4[n], c5[n], f[0]), lerp(c6[n], c7[n], f[0]), f[1]);
             each(lerp(z0, z1, f[2]));
         }
     }
@@ -391,21 +386,24 @@ impl LightGrid {
     /// At most [`MAX_PICKED_LIGHTS`](super::light_choice::MAX_PICKED_LIGHTS) lights: the light choice's.
     pub(crate) fn seen(&self, phase: &Phase, p: Vec3, dir: Vec3) -> PerLight {
         let mut seen = PerLight::zeros(self.kinds.len());
-        let mut out = seen.iter_mut().zip(&self.kinds);
+        let mean_cosine = phase.mean_cosine();
+        let mut i = 0;
         self.lookup_each(p, |slot| {
-            if let Some((seen, &kind)) = out.next() {
-                *seen = Self::seen_in(kind, slot, phase, dir);
+            if let (Some(seen), Some(&kind)) = (seen.get_mut(i), self.kinds.get(i)) {
+                *seen = Self::seen_in(kind, slot, mean_cosine, dir);
             }
+            i += 1;
         });
         seen
     }
 
-    /// The fraction of a light of `kind` seen through a slot.
+    /// The fraction of a light of `kind` seen through a slot by a phase
+    /// function of mean cosine `mean_cosine`.
     #[inline]
-    fn seen_in(kind: LightKind, slot: Vec4, phase: &Phase, dir: Vec3) -> f32 {
+    fn seen_in(kind: LightKind, slot: Vec4, mean_cosine: f32, dir: Vec3) -> f32 {
         match kind {
             LightKind::Distant | LightKind::Sphere | LightKind::Area => slot.x,
-            LightKind::Dome => (slot.x + 3.0 * phase.mean_cosine() * slot.yzw().dot(dir)).max(0.0),
+            LightKind::Dome => (slot.x + 3.0 * mean_cosine * slot.yzw().dot(dir)).max(0.0),
         }
     }
 
@@ -424,7 +422,7 @@ impl LightGrid {
         let mut i = 0;
         self.lookup_each(p, |slot| {
             let light = lights.get(i);
-            let seen = Self::seen_in(light.kind(), slot, phase, dir);
+            let seen = Self::seen_in(light.kind(), slot, phase.mean_cosine(), dir);
             let l = match light {
                 Light::Distant(sun) => {
                     let f = phase.eval(dir, -sun.direction());
