@@ -44,7 +44,8 @@ pub use exr_read::read_env_map;
 pub use film::{AovImage, Halves, Image};
 pub use render::{render, Denoised, Rendered, Window};
 pub use scene::{
-    Budget, Crop, RenderSettings, Scene, DEFAULT_SEED, DEFAULT_SPP, DEFAULT_STEP_VOXELS,
+    fitted_tile_size, Budget, Crop, RenderSettings, Scene, DEFAULT_SEED, DEFAULT_SPP,
+    DEFAULT_STEP_VOXELS, DEFAULT_TILE_SIZE, MIN_TILE_SIZE, TILES_PER_THREAD,
 };
 pub use stats::RenderStats;
 

@@ -14,7 +14,7 @@ use crate::film::{AovImage, Film, Halves, Image, Tile};
 use crate::majorant_choice;
 use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGrid};
 use crate::pixel_sampler::PixelSampler;
-use crate::scene::{Budget, Crop, RenderSettings, Scene};
+use crate::scene::{fitted_tile_size, Budget, Crop, RenderSettings, Scene};
 use crate::stats::RenderStats;
 use cirrus_kernel::integrator::{
     CameraSampler, IntegratorKind, LightGrid, RayMarcher, TwoPassMarcher,
@@ -259,9 +259,11 @@ fn run<S: CameraSampler>(
     counters: &mut Counters,
 ) -> Resolved {
     let crop = crop_of(settings, camera);
+    let (w, h) = (crop.x1 - crop.x0, crop.y1 - crop.y0);
+    let tile_size = fitted_tile_size(settings.tile_size, w, h, rayon::current_num_threads());
     let mut film = Film::new(
-        (crop.x0, crop.y0, crop.x1 - crop.x0, crop.y1 - crop.y0),
-        settings.tile_size,
+        (crop.x0, crop.y0, w, h),
+        tile_size,
         (settings.aovs, settings.halves),
         &settings.compositing,
     );

@@ -2,7 +2,9 @@
 
 mod common;
 
-use cirrus_render::{render, Budget, IntegratorKind, Lights, MajorantMode, Rendered};
+use cirrus_render::{
+    fitted_tile_size, render, Budget, IntegratorKind, Lights, MajorantMode, Rendered,
+};
 
 fn render_with_threads(threads: usize, kind: IntegratorKind, seed: u64) -> Rendered {
     let scene = common::sunlit_cloud();
@@ -80,4 +82,43 @@ fn time_budget_reports_the_samples_it_reached() {
             "{key} missing from {json}"
         );
     }
+}
+
+/// Tiles are units of work only: any tile edge gives the same bits (the
+/// render picks the edge by thread count, [`fitted_tile_size`]).
+#[test]
+fn any_tile_size_gives_the_same_image() {
+    let scene = common::sunlit_cloud();
+    let mut settings = common::settings(IntegratorKind::Path, 8, 3);
+    let threads = rayon::current_num_threads();
+    let mut edges = Vec::new();
+    let mut images = Vec::new();
+    for tile in [16, 5, 1] {
+        settings.tile_size = tile;
+        // The scene's image is 20x20.
+        edges.push(fitted_tile_size(tile, 20, 20, threads));
+        images.push(common::image_bits(&render(&scene, &settings)));
+    }
+    assert!(edges[0] != edges[1] && edges[1] != edges[2], "edges {edges:?}");
+    assert_eq!(images[0], images[1], "edges {edges:?}");
+    assert_eq!(images[0], images[2], "edges {edges:?}");
+}
+
+/// The tile edge halves until each thread has its share of tiles, and
+/// never below 4 unless asked.
+#[test]
+fn the_tile_edge_fits_the_threads() {
+    // 128x128 in 8-pixel tiles: 256 tiles, enough for 16 threads...
+    assert_eq!(fitted_tile_size(8, 128, 128, 16), 8);
+    // ...not for 17 or 64: 4 pixels (1024 tiles), and no smaller.
+    assert_eq!(fitted_tile_size(8, 128, 128, 17), 4);
+    assert_eq!(fitted_tile_size(8, 128, 128, 64), 4);
+    // A large image keeps the edge asked for.
+    assert_eq!(fitted_tile_size(16, 1920, 1080, 64), 16);
+    // 160x120 on 2 threads: 300 tiles of 8 pixels, 80 of 16 (enough).
+    assert_eq!(fitted_tile_size(16, 160, 120, 2), 16);
+    assert_eq!(fitted_tile_size(16, 160, 120, 8), 8);
+    // An edge asked below 4 stays; an empty window does not loop.
+    assert_eq!(fitted_tile_size(3, 64, 64, 64), 3);
+    assert_eq!(fitted_tile_size(8, 0, 0, 4), 4);
 }
