@@ -421,6 +421,11 @@ impl<S: CameraSampler> Passes<'_, S> {
     fn run(&self, film: &mut Film, plan: Plan) -> (Counters, u64) {
         film.tiles
             .par_iter_mut()
+            // One job a tile: rayon runs a split's leaf to its end on one
+            // thread, and idle threads can take only work not yet started,
+            // so leaves of several tiles (a cloud's costly middle among
+            // them) ended renders with threads idle.
+            .with_max_len(1)
             .map(|tile| {
                 let mut c = Counters::default();
                 if self.progress.cancelled() {
