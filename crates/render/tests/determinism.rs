@@ -99,7 +99,10 @@ fn any_tile_size_gives_the_same_image() {
         edges.push(fitted_tile_size(tile, 20, 20, threads));
         images.push(common::image_bits(&render(&scene, &settings)));
     }
-    assert!(edges[0] != edges[1] && edges[1] != edges[2], "edges {edges:?}");
+    assert!(
+        edges[0] != edges[1] && edges[1] != edges[2],
+        "edges {edges:?}"
+    );
     assert_eq!(images[0], images[1], "edges {edges:?}");
     assert_eq!(images[0], images[2], "edges {edges:?}");
 }
