@@ -167,35 +167,49 @@ impl LightGrid {
 
     /// The stored bricks from the computed ones: each brick's points and
     /// the first of its neighbours' beyond its upper faces (the lattice's
-    /// last point repeated past its end, zero in empty bricks).
+    /// last point repeated past its end, zero in empty bricks); `None`
+    /// where every brick it copies from is empty.
     fn stored(&self, computed: &[Option<Box<[Vec4]>>]) -> Vec<Option<Box<[Vec4]>>> {
         let w = self.width;
-        let computed_at = |q: [usize; 3]| {
-            let b =
-                q[0] / BRICK + self.bricks[0] * (q[1] / BRICK + self.bricks[1] * (q[2] / BRICK));
-            let o = q[0] % BRICK + BRICK * (q[1] % BRICK + BRICK * (q[2] % BRICK));
-            computed[b].as_ref().map(|d| &d[o * w..(o + 1) * w])
+        let clamped = |origin: [usize; 3], ijk: [usize; 3]| {
+            [0, 1, 2].map(|a| (origin[a] + ijk[a]).min(self.points[a] - 1))
         };
         (0..computed.len())
             .map(|b| {
                 let origin = self.brick_origin(b);
+                // The bricks it copies from hold its corners.
+                let copies = (0..8).any(|c| {
+                    let corner = [0, 1, 2].map(|a| BRICK * ((c >> a) & 1));
+                    computed[self.place(clamped(origin, corner), BRICK).0].is_some()
+                });
+                if !copies {
+                    return None;
+                }
                 let mut out = vec![Vec4::ZERO; STORED * STORED * STORED * w];
-                let mut any = false;
                 for (local, entry) in out.chunks_exact_mut(w.max(1)).enumerate() {
                     let ijk = [
                         local % STORED,
                         (local / STORED) % STORED,
                         local / (STORED * STORED),
                     ];
-                    let q = [0, 1, 2].map(|a| (origin[a] + ijk[a]).min(self.points[a] - 1));
-                    if let Some(values) = computed_at(q) {
-                        entry.copy_from_slice(values);
-                        any = true;
+                    let (from, o) = self.place(clamped(origin, ijk), BRICK);
+                    if let Some(values) = &computed[from] {
+                        entry.copy_from_slice(&values[o * w..(o + 1) * w]);
                     }
                 }
-                any.then(|| out.into_boxed_slice())
+                Some(out.into_boxed_slice())
             })
             .collect()
+    }
+
+    /// The brick holding lattice point `q` and the point's entry in it,
+    /// for bricks of `edge` entries a side (x fastest): [`BRICK`] as
+    /// computed, [`STORED`] as stored.
+    #[inline]
+    fn place(&self, q: [usize; 3], edge: usize) -> (usize, usize) {
+        let [i, j, k] = q;
+        let b = i / BRICK + self.bricks[0] * (j / BRICK + self.bricks[1] * (k / BRICK));
+        (b, i % BRICK + edge * (j % BRICK + edge * (k % BRICK)))
     }
 
     /// The coarse grid the path tracer's light choice weighs lights by
@@ -323,8 +337,7 @@ impl LightGrid {
     /// computed it, `None` in an empty brick.
     #[cfg(test)]
     fn entry(&self, i: usize, j: usize, k: usize) -> Option<&[Vec4]> {
-        let bi = i / BRICK + self.bricks[0] * (j / BRICK + self.bricks[1] * (k / BRICK));
-        let o = i % BRICK + STORED * (j % BRICK + STORED * (k % BRICK));
+        let (bi, o) = self.place([i, j, k], STORED);
         let brick = self.brick_data[bi].as_ref()?;
         Some(&brick[o * self.width..(o + 1) * self.width])
     }
@@ -356,12 +369,10 @@ impl LightGrid {
     fn lookup_each(&self, p: Vec3, mut each: impl FnMut(Vec4)) {
         let (base, f) = self.stencil(p);
         let w = self.width;
-        let [i, j, k] = base;
-        let bi = i / BRICK + self.bricks[0] * (j / BRICK + self.bricks[1] * (k / BRICK));
+        let (bi, o) = self.place(base, STORED);
         let Some(brick) = &self.brick_data[bi] else {
             return (0..w).for_each(|_| each(Vec4::ZERO));
         };
-        let o = i % BRICK + STORED * (j % BRICK + STORED * (k % BRICK));
         // x fastest in a brick: y one row of STORED on, z one slice.
         const Y: usize = STORED;
         const Z: usize = STORED * STORED;
