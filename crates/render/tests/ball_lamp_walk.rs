@@ -15,6 +15,7 @@ mod common;
 use cirrus_render::{
     render, Camera, ConstantBox, IntegratorKind, Lights, Medium, Scene, SphereLight, Volumes,
 };
+use cirrus_testkit::SplitMix64;
 use glam::{DVec3, Vec3};
 
 const HALF: f64 = 40.0;
@@ -25,19 +26,6 @@ const RADIANCE: f64 = 1.0;
 struct Ball {
     centre: DVec3,
     radius: f64,
-}
-
-/// SplitMix64: the walk's own random numbers.
-struct Random(u64);
-
-impl Random {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 /// The distances along `o + t d` at which it enters and leaves the box,
@@ -79,7 +67,8 @@ fn surface(ball: &Ball, o: DVec3, d: DVec3) -> Option<f64> {
 /// The walk's estimate of the radiance along the camera ray `o + t d`,
 /// and its standard error.
 fn walk(sigma_t: f64, ball: &Ball, o: DVec3, d: DVec3, paths: u32, seed: u64) -> (f64, f64) {
-    let mut rng = Random(seed);
+    // The walk's own random numbers, not the renderer's streams.
+    let mut rng = SplitMix64(seed);
     let (mut sum, mut sum_sq) = (0.0, 0.0);
     for _ in 0..paths {
         let (mut o, mut d) = (o, d);
@@ -88,17 +77,17 @@ fn walk(sigma_t: f64, ball: &Ball, o: DVec3, d: DVec3, paths: u32, seed: u64) ->
             let Some((t_in, t_out)) = box_span(o, d) else {
                 break;
             };
-            let s = t_in - (1.0 - rng.uniform()).ln() / sigma_t;
+            let s = t_in - (1.0 - rng.unit_f64()).ln() / sigma_t;
             let end = s.min(t_out);
             if depth > 0 && surface(ball, o, d).is_some_and(|t| t < end) {
                 gathered += RADIANCE;
             }
-            if s >= t_out || rng.uniform() >= ALBEDO {
+            if s >= t_out || rng.unit_f64() >= ALBEDO {
                 break;
             }
             o += s * d;
-            let z = 1.0 - 2.0 * rng.uniform();
-            let phi = std::f64::consts::TAU * rng.uniform();
+            let z = 1.0 - 2.0 * rng.unit_f64();
+            let phi = std::f64::consts::TAU * rng.unit_f64();
             let r = (1.0 - z * z).max(0.0).sqrt();
             d = DVec3::new(r * phi.cos(), r * phi.sin(), z);
         }

@@ -33,6 +33,11 @@ impl SplitMix64 {
     pub fn unit(&mut self) -> f32 {
         (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
     }
+
+    /// Uniform in `[0, 1)` with 53 bits, for estimators in f64.
+    pub fn unit_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
 }
 
 /// The corpus files in `data/` with one of `extensions` and, when
@@ -80,6 +85,12 @@ mod tests {
         assert_eq!(r.next_u64(), 0xE220_A839_7B1D_CDAF);
         assert_eq!(r.next_u64(), 0x6E78_9E6A_A1B9_65F4);
         assert_eq!(r.next_u64(), 0x06C4_5D18_8009_454F);
+        // The next output's top 53 bits, scaled.
+        let mut r = SplitMix64(0);
+        assert_eq!(
+            r.unit_f64(),
+            (0xE220_A839_7B1D_CDAF_u64 >> 11) as f64 / 2f64.powi(53)
+        );
     }
 
     #[test]
