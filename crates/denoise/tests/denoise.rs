@@ -7,6 +7,7 @@
 use std::path::PathBuf;
 
 use cirrus_denoise::{DenoiseError, Denoiser, SearchPath};
+use cirrus_testkit::SplitMix64;
 
 /// The denoiser, or `None` (after saying why) when the test should be skipped.
 fn denoiser(test: &str) -> Option<Denoiser> {
@@ -29,21 +30,13 @@ fn denoiser(test: &str) -> Option<Denoiser> {
     }
 }
 
-/// SplitMix64, for noise that is the same on every run.
-struct Rng(u64);
+/// The tests' SplitMix64, for noise that is the same on every run.
+struct Rng(SplitMix64);
 
 impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
     /// Uniform in (0, 1].
     fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) + 1) as f64 / (1u64 << 53) as f64
+        ((self.0.next_u64() >> 11) + 1) as f64 / (1u64 << 53) as f64
     }
 
     /// Standard normal (Box-Muller).
@@ -81,7 +74,7 @@ fn clean_image() -> (Vec<f32>, Vec<f32>) {
 }
 
 fn add_noise(clean: &[f32], seed: u64) -> Vec<f32> {
-    let mut rng = Rng(seed);
+    let mut rng = Rng(SplitMix64(seed));
     clean
         .iter()
         .map(|&v| (v as f64 + SIGMA * rng.gaussian()) as f32)
