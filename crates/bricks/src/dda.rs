@@ -50,7 +50,7 @@ use crate::partition::{Cell, CellPartition};
 use crate::segment::MajorantSegment;
 use crate::volume::BrickVolume;
 use crate::voxel_of::voxel_of;
-use glam::{IVec3, Vec3};
+use glam::{BVec3A, IVec3, Vec3, Vec3A};
 
 /// A ray in a volume's local index space, clipped to the volume's box, and
 /// the walk's position `t` along it: what every cell walk over a
@@ -58,10 +58,12 @@ use glam::{IVec3, Vec3};
 /// `lattice.rs`).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CellRay {
-    pub origin: Vec3,
-    pub dir: Vec3,
+    /// In vector lanes, as are the direction and its inverse: every step
+    /// computes with all three axes at once.
+    origin: Vec3A,
+    dir: Vec3A,
     /// `1 / dir`, with `+inf` where a component is zero (it never exits).
-    inv_dir: Vec3,
+    inv_dir: Vec3A,
     /// Where the walk is.
     pub t: f32,
     /// Where the ray leaves the volume (or ends).
@@ -69,7 +71,7 @@ pub(crate) struct CellRay {
     /// Absolute part of the nudge: 1e-5 voxels along the ray's major axis.
     nudge_abs: f32,
     /// Per axis, whether the ray leaves a cell through its upper face.
-    upward: glam::BVec3,
+    upward: BVec3A,
 }
 
 impl CellRay {
@@ -87,14 +89,20 @@ impl CellRay {
             (0.0, 0.0)
         };
         CellRay {
-            origin,
-            dir,
-            inv_dir,
+            origin: origin.into(),
+            dir: dir.into(),
+            inv_dir: inv_dir.into(),
             t,
             t_end,
             nudge_abs: 1e-5 / dir.abs().max_element(),
-            upward: dir.cmpge(Vec3::ZERO),
+            upward: Vec3A::from(dir).cmpge(Vec3A::ZERO),
         }
+    }
+
+    /// The point at `t`.
+    #[inline]
+    pub fn point(&self, t: f32) -> Vec3A {
+        self.origin + self.dir * t
     }
 
     /// How far past `t` the walk looks up the cell it is in (see the
@@ -109,9 +117,12 @@ impl CellRay {
     /// to the end of the ray; returns the `t` it left from. Every step ends
     /// here, so every step makes progress (the module doc's guarantee).
     #[inline]
-    pub fn leave(&mut self, lo: Vec3, hi: Vec3, nudge: f32) -> f32 {
-        let far = Vec3::select(self.upward, hi, lo);
-        let exit = ((far - self.origin) * self.inv_dir).min_element();
+    pub fn leave(&mut self, lo: Vec3A, hi: Vec3A, nudge: f32) -> f32 {
+        let far = Vec3A::select(self.upward, hi, lo);
+        let exits = (far - self.origin) * self.inv_dir;
+        // An axis the ray never crosses, from a point on one of its faces,
+        // gives 0 x inf = NaN: it bounds nothing (as `f32::min` would skip it).
+        let exit = Vec3A::select(exits.is_nan_mask(), Vec3A::INFINITY, exits).min_element();
         let t0 = self.t;
         self.t = exit.max(t0 + nudge).min(self.t_end);
         t0
@@ -123,8 +134,8 @@ impl CellRay {
     pub fn leave_empty(&mut self, c1: IVec3, distance: u32, nudge: f32) {
         let r = distance as i32 - 1;
         let side = (1 << (CELL_LOG2 + 1)) as f32;
-        let lo = (c1 - r).as_vec3() * side;
-        let hi = (c1 + (r + 1)).as_vec3() * side;
+        let lo = (c1 - r).as_vec3a() * side;
+        let hi = (c1 + (r + 1)).as_vec3a() * side;
         self.leave(lo, hi, nudge);
     }
 }
@@ -161,19 +172,49 @@ impl Iterator for SegmentIter<'_> {
 
     /// The segment of the next cell with density, or `None` at the end of
     /// the ray.
+    #[inline]
     fn next(&mut self) -> Option<MajorantSegment> {
+        loop {
+            match self.walk() {
+                Found::Segment(s) => return Some(s),
+                Found::End => return None,
+                Found::VoxelCell(voxel, nudge) => {
+                    if let Some(s) = self.voxel_cell(voxel, nudge) {
+                        return Some(s);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Where [`SegmentIter::walk`] stopped.
+enum Found {
+    Segment(MajorantSegment),
+    End,
+    /// A finest cell to be walked voxel by voxel, at this voxel (located
+    /// with this nudge).
+    VoxelCell(IVec3, f32),
+}
+
+impl SegmentIter<'_> {
+    /// Walks to the next segment of a kept cell with density, or to the
+    /// end, or to a cell the walk takes voxel by voxel. Nothing in the loop
+    /// calls out, so the ray stays in registers: with the rare voxel cells'
+    /// call inside it, every call of `next` saved and restored them all.
+    #[inline(always)]
+    fn walk(&mut self) -> Found {
         let levels = &self.volume.levels;
         let ray = &mut self.ray;
         while ray.t < ray.t_end {
             self.steps += 1;
             let nudge = ray.nudge();
-            let p = ray.origin + ray.dir * (ray.t + nudge);
-            let voxel = voxel_of(p);
+            let voxel = voxel_of(ray.point(ray.t + nudge));
             // The kept cell or empty cube holding `p` (`partition.rs`): one
             // table read. A point outside the volume (only ever by a nudge
             // past its face) is in an empty level-0 cell.
             let c1 = voxel >> (CELL_LOG2 + 1) as i32;
-            let (l, (mut lo, mut hi)) = match self.partition.cell_at(c1) {
+            let (l, (lo, hi)) = match self.partition.cell_at(c1) {
                 // Level-l cells hold whole level-1 cells, and level 0 has
                 // twice level 1's cells per axis: `voxel >> shift` is inside.
                 Some(Cell::Kept(l)) => (
@@ -191,28 +232,40 @@ impl Iterator for SegmentIter<'_> {
                 None => (0, (0.0, 0.0)),
             };
             let shift = (CELL_LOG2 + l as u32) as i32;
-            let mut size = (1i32 << shift) as f32;
-            let mut cell_lo = (voxel >> shift).as_vec3() * size;
+            let size = (1i32 << shift) as f32;
             if l == 0 && hi > lo && (hi - lo) * size > self.partition.voxel_split {
-                // A finest cell so optically thick that even its few voxels
-                // of slack cost many null collisions: bound the one voxel
-                // cell [v, v + 1) by its eight corner voxels instead.
-                (lo, hi) = self.volume.voxel_cell_range(voxel);
-                size = 1.0;
-                cell_lo = voxel.as_vec3();
+                return Found::VoxelCell(voxel, nudge);
             }
-            let t0 = ray.leave(cell_lo, cell_lo + Vec3::splat(size), nudge);
-            let t1 = ray.t;
+            let cell_lo = (voxel >> shift).as_vec3a() * size;
+            let t0 = ray.leave(cell_lo, cell_lo + Vec3A::splat(size), nudge);
             if hi > 0.0 {
-                return Some(MajorantSegment {
+                return Found::Segment(MajorantSegment {
                     t0,
-                    t1,
+                    t1: ray.t,
                     minorant: lo,
                     majorant: hi,
                 });
             }
         }
-        None
+        Found::End
+    }
+
+    /// A finest cell so optically thick that even its few voxels of slack
+    /// cost many null collisions: the one voxel cell `[voxel, voxel + 1)`
+    /// bounded by its eight corner voxels instead, its segment if it has
+    /// density.
+    #[cold]
+    #[inline(never)]
+    fn voxel_cell(&mut self, voxel: IVec3, nudge: f32) -> Option<MajorantSegment> {
+        let (lo, hi) = self.volume.voxel_cell_range(voxel);
+        let cell_lo = voxel.as_vec3a();
+        let t0 = self.ray.leave(cell_lo, cell_lo + Vec3A::ONE, nudge);
+        (hi > 0.0).then_some(MajorantSegment {
+            t0,
+            t1: self.ray.t,
+            minorant: lo,
+            majorant: hi,
+        })
     }
 }
 

@@ -28,7 +28,7 @@ use crate::segment::MajorantSegment;
 use crate::volume::BrickVolume;
 use crate::voxel_of::voxel_of;
 use crate::CELL_LOG2;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 /// The points `t_k = org + (k + u) h` of a jittered march: `h` the step,
 /// `u` in `[0, 1)` the ray's jitter.
@@ -123,7 +123,7 @@ impl BrickVolume {
                 return steps;
             }
             let nudge = ray.nudge();
-            let voxel = voxel_of(ray.origin + ray.dir * (ray.t + nudge));
+            let voxel = voxel_of(ray.point(ray.t + nudge));
             let c1 = voxel >> C1_SHIFT;
             match partition.cell_at(c1) {
                 Some(Cell::Kept(_)) => break ray.t,
@@ -132,8 +132,8 @@ impl BrickVolume {
                 // cell, as the segment walk takes it.
                 None => {
                     let size = (1 << CELL_LOG2) as f32;
-                    let lo = (voxel >> CELL_LOG2 as i32).as_vec3() * size;
-                    ray.leave(lo, lo + Vec3::splat(size), nudge);
+                    let lo = (voxel >> CELL_LOG2 as i32).as_vec3a() * size;
+                    ray.leave(lo, lo + Vec3A::splat(size), nudge);
                 }
             }
             steps += 1;
@@ -145,7 +145,7 @@ impl BrickVolume {
                 return steps;
             }
             let p = origin + dir * t;
-            let c1 = voxel_of(p) >> C1_SHIFT;
+            let c1 = voxel_of(p.into()) >> C1_SHIFT;
             k += 1;
             match partition.cell_at(c1) {
                 Some(Cell::Kept(_)) => {

@@ -438,7 +438,7 @@ impl BrickVolume {
         if !p.is_finite() {
             return 0.0;
         }
-        let c = voxel_of(p);
+        let c = voxel_of(p.into());
         let f = p - c.as_vec3();
         let v = if (c & 7).cmplt(IVec3::splat(7)).all() {
             match self.brick_ref(c >> BRICK_LOG2 as i32) {

@@ -10,20 +10,21 @@
 //! agree; beyond it either answer is a cell outside the volume, which every
 //! caller bounds-checks.
 
-use glam::{IVec3, Vec3};
+use glam::{IVec3, Vec3A};
 
 /// `floor(p)` per axis (see the module doc for out-of-range axes).
 #[inline(always)]
-pub(crate) fn voxel_of(p: Vec3) -> IVec3 {
+pub(crate) fn voxel_of(p: Vec3A) -> IVec3 {
     #[cfg(all(target_arch = "x86_64", target_feature = "sse4.1"))]
     {
-        use std::arch::x86_64::{_mm_cvttps_epi32, _mm_floor_ps, _mm_set_ps, _mm_storeu_si128};
+        use std::arch::x86_64::{_mm_cvttps_epi32, _mm_floor_ps, _mm_storeu_si128};
         let mut out = [0i32; 4];
         // SAFETY: the intrinsics need SSE4.1, which this code is compiled
         // with (the cfg above), so every CPU that runs it has it; `out` is
-        // 16 writable bytes and `storeu` needs no alignment.
+        // 16 writable bytes and `storeu` needs no alignment. The fourth
+        // lane, whatever it holds, is converted and dropped.
         unsafe {
-            let v = _mm_cvttps_epi32(_mm_floor_ps(_mm_set_ps(0.0, p.z, p.y, p.x)));
+            let v = _mm_cvttps_epi32(_mm_floor_ps(p.into()));
             _mm_storeu_si128(out.as_mut_ptr().cast(), v);
         }
         IVec3::new(out[0], out[1], out[2])
@@ -37,6 +38,7 @@ pub(crate) fn voxel_of(p: Vec3) -> IVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     /// Agrees with `floor` then the saturating cast wherever a point is in
     /// range: integers, halves, values just below integers, negatives.
@@ -66,7 +68,7 @@ mod tests {
             for &y in &values {
                 for &z in &[values[3], values[9], values[14]] {
                     let p = Vec3::new(x, y, z);
-                    assert_eq!(voxel_of(p), p.floor().as_ivec3(), "{p}");
+                    assert_eq!(voxel_of(p.into()), p.floor().as_ivec3(), "{p}");
                 }
             }
         }
@@ -78,7 +80,7 @@ mod tests {
     #[test]
     fn voxel_of_out_of_range_is_far_outside() {
         for x in [f32::NAN, 3.0e9, -3.0e9, f32::INFINITY, f32::NEG_INFINITY] {
-            let v = voxel_of(Vec3::new(x, 1.5, -2.5));
+            let v = voxel_of(Vec3A::new(x, 1.5, -2.5));
             assert_eq!(v, IVec3::new(i32::MIN, 1, -3), "{x}");
         }
     }
