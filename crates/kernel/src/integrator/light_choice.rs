@@ -51,7 +51,8 @@ use glam::Vec3;
 use super::light_sampling::LightSampling;
 use super::many_lights::ManyLights;
 use super::per_light::{
-    into_shares, lane_shares, lanes_of, raise_to_floors, Lanes, Shares, MIN_PROBABILITY,
+    into_shares, lane_shares, lanes_of, raise_to_floors, share_of_two, Lanes, Shares,
+    MIN_PROBABILITY,
 };
 pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
 use crate::light::{AreaLight, Light, Lights, SphereLight};
@@ -301,9 +302,14 @@ impl LightSampler {
         if !self.picks() {
             return 1.0;
         }
-        let mut w = self.isotropic;
-        w[light] = self.luminance[light] * f;
-        let share = Shares::of(w.iter().copied()).share(w[light]);
+        let own = self.luminance[light] * f;
+        let share = if let [a, b] = *self.isotropic {
+            share_of_two(own, if light == 0 { b } else { a })
+        } else {
+            let mut w = self.isotropic;
+            w[light] = own;
+            Shares::of(w.iter().copied()).share(own)
+        };
         let disc = self.disc[light];
         if disc > 0.0 {
             share.max(disc_floor(f, disc))

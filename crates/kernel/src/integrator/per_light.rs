@@ -149,6 +149,33 @@ impl Shares {
     }
 }
 
+/// [`Shares::of`]`([w, other])`'s share of `w`, bit for bit, for the
+/// commonest scene (a sun and a sky): where the general rule copies the
+/// weights and walks them twice, two lights need one division each.
+/// Their sum is the same in either order, and of two shares summing to one
+/// at most one is below the floor; if one is, the other alone is scaled.
+#[inline]
+pub(super) fn share_of_two(w: f32, other: f32) -> f32 {
+    let total = w + other;
+    let floor = defensive_floor(2);
+    if !(total > 0.0 && total.is_finite()) {
+        return 0.5;
+    }
+    let p = w / total;
+    if p < floor {
+        return floor;
+    }
+    if other / total >= floor {
+        return p;
+    }
+    let scale = (1.0 - floor) / p;
+    if scale == 1.0 {
+        p
+    } else {
+        p * scale
+    }
+}
+
 /// A [`PerLight`]'s values as two four-lane vectors.
 pub(super) type Lanes = [Vec4; 2];
 
@@ -228,6 +255,41 @@ mod tests {
             let one = Shares::of(w.iter().copied());
             for (i, &p) in all.iter().enumerate() {
                 assert!((one.share(w[i]) - p).abs() <= 1e-7, "{w:?}: light {i}");
+            }
+        }
+    }
+
+    /// Two lights' share is the general rule's to the bit, over weights
+    /// from zero through the floor's edge to overflow and NaN.
+    #[test]
+    fn two_lights_share_as_the_general_rule() {
+        let mut rng = cirrus_testkit::SplitMix64(5);
+        let special = [
+            0.0,
+            1e-30,
+            0.05,
+            0.0526315,
+            0.95,
+            1.0,
+            19.0,
+            1e30,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NAN,
+        ];
+        let mut pairs: Vec<(f32, f32)> = special
+            .iter()
+            .flat_map(|&a| special.iter().map(move |&b| (a, b)))
+            .collect();
+        for _ in 0..100_000 {
+            let scale = 10f32.powi(rng.below(9) as i32 - 4);
+            pairs.push((rng.unit() * scale, rng.unit()));
+        }
+        for (a, b) in pairs {
+            for (w, other, i) in [(a, b, 0), (b, a, 1)] {
+                let general = Shares::of([a, b].into_iter()).share([a, b][i]);
+                let two = share_of_two(w, other);
+                assert_eq!(two.to_bits(), general.to_bits(), "{a} {b}: light {i}");
             }
         }
     }
