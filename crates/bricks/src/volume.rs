@@ -4,7 +4,7 @@
 use crate::bounds::BoundsLevel;
 use crate::f16::f16_bits_to_f32;
 #[cfg(target_arch = "x86_64")]
-use crate::f16::{f16x8_to_f32_f16c, has_f16c};
+use crate::f16::{f16_pairs_to_f32_f16c, f16x8_to_f32_f16c, has_f16c};
 use crate::layout::{voxel_offset, BrickRef, Precision, BRICK_LOG2};
 use crate::partition::CellPartition;
 use crate::section::Section;
@@ -160,8 +160,9 @@ impl BrickVolume {
         {
             return BrickRef::Empty;
         }
-        let i = (b.x as usize * self.dims[1] as usize + b.y as usize) * self.dims[2] as usize
-            + b.z as usize;
+        // Two independent products (see `BoundsLevel::index`).
+        let [_, dy, dz] = self.dims.map(|d| d as usize);
+        let i = b.x as usize * (dy * dz) + (b.y as usize * dz + b.z as usize);
         BrickRef::decode(self.map[i])
     }
 
@@ -390,7 +391,8 @@ impl BrickVolume {
             |b, n| {
                 let base = b as usize * 512 + n;
                 let s = &atlas[base..base + 74];
-                f16x8_to_f32_f16c([s[0], s[1], s[8], s[9], s[64], s[65], s[72], s[73]])
+                let pair = |i: usize| u32::from(s[i]) | u32::from(s[i + 1]) << 16;
+                f16_pairs_to_f32_f16c([pair(0), pair(8), pair(64), pair(72)])
             },
             |c| match self.straddling_f16_bits(atlas, c) {
                 Some(raw) => f16x8_to_f32_f16c(raw),
