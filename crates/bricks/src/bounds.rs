@@ -36,10 +36,13 @@ pub struct BoundsLevel {
 }
 
 impl BoundsLevel {
+    /// The x-major index of cell `c`, as `x (dy dz) + (y dz + z)`: the
+    /// two products independent, where `(x dy + y) dz + z` chains them
+    /// (the index is on every cell walk step's critical path).
     #[inline]
     pub fn index(&self, c: [u32; 3]) -> usize {
-        ((c[0] as usize * self.dims[1] as usize) + c[1] as usize) * self.dims[2] as usize
-            + c[2] as usize
+        let [_, dy, dz] = self.dims.map(|d| d as usize);
+        c[0] as usize * (dy * dz) + (c[1] as usize * dz + c[2] as usize)
     }
 
     /// (min, max) of a cell; cells outside the level are (0, 0).

@@ -124,7 +124,13 @@ impl CellRay {
         // gives 0 x inf = NaN: it bounds nothing (as `f32::min` would skip it).
         let exit = Vec3A::select(exits.is_nan_mask(), Vec3A::INFINITY, exits).min_element();
         let t0 = self.t;
-        self.t = exit.max(t0 + nudge).min(self.t_end);
+        // `exit` is never NaN (NaN lanes were dropped), nor are the ray's
+        // ends, so plain compares give `exit.max(..).min(t_end)` without
+        // the NaN fix-ups `f32::max` and `min` compile to, a few cycles on
+        // the step's critical path.
+        let least = t0 + nudge;
+        let t = if exit > least { exit } else { least };
+        self.t = if t < self.t_end { t } else { self.t_end };
         t0
     }
 
@@ -214,7 +220,15 @@ impl SegmentIter<'_> {
             // table read. A point outside the volume (only ever by a nudge
             // past its face) is in an empty level-0 cell.
             let c1 = voxel >> (CELL_LOG2 + 1) as i32;
+            // The level-0 cell's bounds, read beside the partition's code
+            // rather than after it: most kept cells of a dense cloud are
+            // finest cells, and the code's level then no longer delays
+            // their read (the walk is a chain of dependent reads).
+            let finest = levels.first().map_or((0.0, 0.0), |l0| {
+                l0.get((voxel >> CELL_LOG2 as i32).to_array())
+            });
             let (l, (lo, hi)) = match self.partition.cell_at(c1) {
+                Some(Cell::Kept(0)) => (0, finest),
                 // Level-l cells hold whole level-1 cells, and level 0 has
                 // twice level 1's cells per axis: `voxel >> shift` is inside.
                 Some(Cell::Kept(l)) => (

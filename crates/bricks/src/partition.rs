@@ -76,7 +76,9 @@ impl CellPartition {
         if x >= dx || y >= dy || z >= dz {
             return None;
         }
-        let i = (x as usize * dy as usize + y as usize) * dz as usize + z as usize;
+        // Two independent products (see `BoundsLevel::index`).
+        let (dy, dz) = (dy as usize, dz as usize);
+        let i = x as usize * (dy * dz) + (y as usize * dz + z as usize);
         let code = self.levels[i];
         Some(if code & EMPTY != 0 {
             Cell::Empty {
