@@ -111,6 +111,49 @@ impl BrickVolume {
         dir: Vec3,
         t_max: f32,
         lattice: Lattice,
+        visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        let ray = (origin, dir, t_max);
+        #[cfg(target_arch = "x86_64")]
+        if let Some(atlas) = self.f16c_atlas() {
+            // SAFETY: `f16c_atlas` is `Some` only where the CPU has F16C.
+            return unsafe { self.march_occupied_f16c(atlas, partition, ray, lattice, visit) };
+        }
+        self.march_with(partition, ray, lattice, |p| self.trilinear(p), visit)
+    }
+
+    /// [`Self::march_occupied`] compiled with F16C, over an f16 atlas: the
+    /// lookups inline into the march (a `target_feature` function inlines
+    /// only into another), where each point paid two calls. Measured on
+    /// the corpus cloud's ray march, a lookup every point: 0.944 of the
+    /// time on one thread.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "f16c")]
+    fn march_occupied_f16c(
+        &self,
+        atlas: &[u16],
+        partition: &CellPartition,
+        ray: (Vec3, Vec3, f32),
+        lattice: Lattice,
+        visit: impl FnMut(f32, f32) -> bool,
+    ) -> u64 {
+        self.march_with(
+            partition,
+            ray,
+            lattice,
+            |p| self.trilinear_f16c(atlas, p),
+            visit,
+        )
+    }
+
+    /// The march of [`Self::march_occupied`] with `lookup` for the density.
+    #[inline(always)]
+    fn march_with(
+        &self,
+        partition: &CellPartition,
+        (origin, dir, t_max): (Vec3, Vec3, f32),
+        lattice: Lattice,
+        lookup: impl Fn(Vec3) -> f32,
         mut visit: impl FnMut(f32, f32) -> bool,
     ) -> u64 {
         const C1_SHIFT: i32 = (CELL_LOG2 + 1) as i32;
@@ -149,7 +192,7 @@ impl BrickVolume {
             k += 1;
             match partition.cell_at(c1) {
                 Some(Cell::Kept(_)) => {
-                    let more = visit(t, self.trilinear(p));
+                    let more = visit(t, lookup(p));
                     if !more {
                         return steps;
                     }

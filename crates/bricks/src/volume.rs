@@ -365,11 +365,9 @@ impl BrickVolume {
     #[inline]
     pub fn trilinear(&self, p: Vec3) -> f32 {
         #[cfg(target_arch = "x86_64")]
-        if let Atlas::F16(a) = &self.atlas {
-            if has_f16c() {
-                // SAFETY: the CPU has F16C, checked just above.
-                return unsafe { self.trilinear_f16c(a, p) };
-            }
+        if let Some(a) = self.f16c_atlas() {
+            // SAFETY: `f16c_atlas` is `Some` only where the CPU has F16C.
+            return unsafe { self.trilinear_f16c(a, p) };
         }
         self.trilinear_with(
             p,
@@ -385,7 +383,8 @@ impl BrickVolume {
     /// slower than one over an f32 atlas.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "f16c")]
-    fn trilinear_f16c(&self, atlas: &[u16], p: Vec3) -> f32 {
+    #[inline]
+    pub(crate) fn trilinear_f16c(&self, atlas: &[u16], p: Vec3) -> f32 {
         self.trilinear_with(
             p,
             |b, n| {
@@ -399,6 +398,16 @@ impl BrickVolume {
                 None => self.straddling_corners(c),
             },
         )
+    }
+
+    /// The f16 atlas, where the CPU has F16C to decode it with.
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    pub(crate) fn f16c_atlas(&self) -> Option<&[u16]> {
+        match &self.atlas {
+            Atlas::F16(a) if has_f16c() => Some(a),
+            _ => None,
+        }
     }
 
     /// The raw f16 corners of a stencil across brick faces (0 for empty
