@@ -54,8 +54,8 @@ pub(crate) fn has_f16c() -> bool {
 #[target_feature(enable = "f16c")]
 #[inline]
 pub(crate) fn f16x8_to_f32_f16c(h: [u16; 8]) -> [f32; 8] {
-    use std::arch::x86_64::{__m128, _mm_cvtph_ps, _mm_set_epi16, _mm_srli_si128};
-    let v = _mm_set_epi16(
+    use std::arch::x86_64::_mm_set_epi16;
+    decode8(_mm_set_epi16(
         h[7] as i16,
         h[6] as i16,
         h[5] as i16,
@@ -64,18 +64,7 @@ pub(crate) fn f16x8_to_f32_f16c(h: [u16; 8]) -> [f32; 8] {
         h[2] as i16,
         h[1] as i16,
         h[0] as i16,
-    );
-    let lo = _mm_cvtph_ps(v);
-    let hi = _mm_cvtph_ps(_mm_srli_si128::<8>(v));
-    // SAFETY: `__m128` is 16 bytes of four f32 lanes, as `[f32; 4]` is,
-    // and every bit pattern is a valid f32.
-    let (lo, hi): ([f32; 4], [f32; 4]) = unsafe {
-        (
-            std::mem::transmute::<__m128, [f32; 4]>(lo),
-            std::mem::transmute::<__m128, [f32; 4]>(hi),
-        )
-    };
-    [lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]]
+    ))
 }
 
 /// [`f16x8_to_f32_f16c`] of four pairs of adjacent f16s, each pair one
@@ -87,18 +76,24 @@ pub(crate) fn f16x8_to_f32_f16c(h: [u16; 8]) -> [f32; 8] {
 #[target_feature(enable = "f16c")]
 #[inline]
 pub(crate) fn f16_pairs_to_f32_f16c(pairs: [u32; 4]) -> [f32; 8] {
-    use std::arch::x86_64::{
-        __m128, _mm_cvtph_ps, _mm_cvtsi32_si128, _mm_srli_si128, _mm_unpacklo_epi32,
-        _mm_unpacklo_epi64,
-    };
+    use std::arch::x86_64::{_mm_cvtsi32_si128, _mm_unpacklo_epi32, _mm_unpacklo_epi64};
     let lane = |p: u32| _mm_cvtsi32_si128(p as i32);
-    let v = _mm_unpacklo_epi64(
+    decode8(_mm_unpacklo_epi64(
         _mm_unpacklo_epi32(lane(pairs[0]), lane(pairs[1])),
         _mm_unpacklo_epi32(lane(pairs[2]), lane(pairs[3])),
-    );
+    ))
+}
+
+/// The eight f16 lanes of `v` as f32s, by two `vcvtph2ps`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "f16c")]
+#[inline]
+fn decode8(v: std::arch::x86_64::__m128i) -> [f32; 8] {
+    use std::arch::x86_64::{__m128, _mm_cvtph_ps, _mm_srli_si128};
     let lo = _mm_cvtph_ps(v);
     let hi = _mm_cvtph_ps(_mm_srli_si128::<8>(v));
-    // SAFETY: as in `f16x8_to_f32_f16c`.
+    // SAFETY: `__m128` is 16 bytes of four f32 lanes, as `[f32; 4]` is,
+    // and every bit pattern is a valid f32.
     let (lo, hi): ([f32; 4], [f32; 4]) = unsafe {
         (
             std::mem::transmute::<__m128, [f32; 4]>(lo),
