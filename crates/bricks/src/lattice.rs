@@ -141,7 +141,7 @@ impl BrickVolume {
             partition,
             ray,
             lattice,
-            |p| self.trilinear_f16c(atlas, p),
+            |p| self.trilinear_f16c_inlined(atlas, p),
             visit,
         )
     }
