@@ -7,6 +7,8 @@
 //! - [`error`]: run time against error for every estimator and majorant
 //!   structure, against a converged reference, plotted by [`plot`], with
 //!   the ceiling any majorant structure has on the scene (`error/ceiling.rs`);
+//! - [`interleave`]: free flights one at a time against two at a time on
+//!   one thread, what overlapping paths' chains gains on a core;
 //! - [`stress`]: extreme inputs, each checked for finite images and, where
 //!   one exists, against a closed-form answer.
 //!
@@ -16,6 +18,7 @@
 pub mod baseline;
 pub mod error;
 pub mod fixed_grid;
+pub mod interleave;
 pub mod measure;
 pub mod plot;
 pub mod stress;
@@ -38,6 +41,8 @@ pub enum BenchCommand {
     /// Numerical stress: extreme scales, sizes, positions, grazing rays,
     /// cameras inside volumes, bad voxels, underflowing optical depths.
     Stress(stress::StressArgs),
+    /// Free flights one at a time against two at a time on one thread.
+    Interleave(interleave::InterleaveArgs),
 }
 
 pub fn run(cmd: &BenchCommand) -> BenchResult {
@@ -45,6 +50,7 @@ pub fn run(cmd: &BenchCommand) -> BenchResult {
         BenchCommand::Traverse(args) => traverse::run(args),
         BenchCommand::Error(args) => error::run(args),
         BenchCommand::Stress(args) => stress::run(args),
+        BenchCommand::Interleave(args) => interleave::run(args),
     }
 }
 

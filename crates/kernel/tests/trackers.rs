@@ -2,8 +2,8 @@
 //! forms and quadrature.
 
 use cirrus_kernel::tracking::{
-    ratio_tracking, residual_ratio_tracking, sample_free_flight, track_length_transmittance,
-    transmittance, FreeFlight, TransmittanceEstimator,
+    ratio_tracking, residual_ratio_tracking, sample_free_flight, sample_free_flight_pair,
+    track_length_transmittance, transmittance, FreeFlight, TransmittanceEstimator,
 };
 use cirrus_kernel::Bounds3;
 use cirrus_kernel::{ConstantBox, Counters, DensityField, GlobalMedia, Media, Medium, Volumes};
@@ -270,4 +270,73 @@ fn delta_tracked_flights_collide_with_density_sigma_t_times_transmittance() {
         "{uniform} vs {exact_at}"
     );
     assert!(c.null_collisions > c.real_collisions / 4, "{c:?}");
+}
+
+/// Paired flights against the same flights one at a time, for
+/// spectrum `S`: every flight's end, weight and generator state, and the
+/// counters, are the same bit for bit.
+fn pairs_match_single_flights<S: cirrus_kernel::Spectrum, M: Media>(medium: &M, centre: Vec3) {
+    let ray = |i: u64| {
+        let a = i as f32 * 0.7;
+        let dir = Vec3::new(a.cos(), 0.3 * (1.3 * a).sin(), a.sin()).normalize();
+        Ray::new(
+            centre - 2.0 * dir + Vec3::new(0.0, 0.05 * (i % 7) as f32, 0.0),
+            dir,
+        )
+    };
+    let (mut single, mut paired) = (Counters::default(), Counters::default());
+    let mut ends = [0u32; 2];
+    for i in (0..2_000u64).step_by(2) {
+        let (r0, r1) = (ray(i), ray(i + 1));
+        let t_max = [f32::INFINITY, if i % 6 == 0 { 1.5 } else { f32::INFINITY }];
+        let mut alone = [Rng::new(4, i, 0), Rng::new(4, i + 1, 0)];
+        let mut beta_alone = [Vec3::ONE; 2];
+        let [ga, gb] = &mut alone;
+        let [ba, bb] = &mut beta_alone;
+        let expected = [
+            sample_free_flight::<S, _>(medium, &r0, t_max[0], ba, ga, &mut single),
+            sample_free_flight::<S, _>(medium, &r1, t_max[1], bb, gb, &mut single),
+        ];
+        let mut both = [Rng::new(4, i, 0), Rng::new(4, i + 1, 0)];
+        let mut beta_both = [Vec3::ONE; 2];
+        let [ga, gb] = &mut both;
+        let [ba, bb] = &mut beta_both;
+        let got = sample_free_flight_pair::<S, _>(
+            medium,
+            [&r0, &r1],
+            t_max,
+            [ba, bb],
+            [ga, gb],
+            &mut paired,
+        );
+        assert_eq!(got, expected, "pair {i}");
+        assert_eq!(beta_both, beta_alone, "pair {i}");
+        for k in 0..2 {
+            assert_eq!(
+                both[k].uniform().to_bits(),
+                alone[k].uniform().to_bits(),
+                "pair {i}"
+            );
+            ends[usize::from(matches!(got[k], FreeFlight::Escaped))] += 1;
+        }
+    }
+    assert_eq!(paired, single);
+    // Both kinds of ending occur, so the test can tell an early stop.
+    assert!(
+        ends[0] > 200 && ends[1] > 200,
+        "collisions and escapes: {ends:?}"
+    );
+}
+
+#[test]
+fn paired_flights_end_where_single_flights_do() {
+    let field = GridField::cloud(4, Vec3::ZERO);
+    let Bounds3 { min: lo, max: hi } = field.bounds();
+    let centre = 0.5 * (lo + hi);
+    let grey = Volumes::from(Medium::new(field.clone(), 6.0, Vec3::ONE, 0.0));
+    pairs_match_single_flights::<f32, _>(&grey, centre);
+    let tinted = Volumes::from(
+        Medium::new(field, 6.0, Vec3::ONE, 0.0).with_extinction_tint(Vec3::new(0.5, 1.0, 1.5)),
+    );
+    pairs_match_single_flights::<Vec3, _>(&tinted, centre);
 }

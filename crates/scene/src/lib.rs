@@ -70,7 +70,7 @@ pub use error::{Error, ErrorKind, Result};
 pub use flags::{settings_table, SceneFlags};
 pub use output::{write_whole, Outputs};
 pub use overrides::{examples, settings, Overrides};
-pub use plan::VolumeCache;
+pub use plan::{VolumeCache, DENSITY_SCALE_PER_VOXEL};
 pub use prepare::{Placement, Prepared};
 pub use scene::Scene;
 pub use settings::SceneSettings;

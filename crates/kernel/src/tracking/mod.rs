@@ -19,7 +19,7 @@ pub(crate) mod roulette;
 mod track_length;
 mod walk;
 
-pub use delta::{sample_free_flight, FreeFlight};
+pub use delta::{sample_free_flight, sample_free_flight_pair, FreeFlight};
 pub use ratio::ratio_tracking;
 pub use residual::residual_ratio_tracking;
 pub use track_length::track_length_transmittance;
