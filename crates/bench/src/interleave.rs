@@ -6,7 +6,7 @@
 //! decision), so one core runs it well below its width; two independent
 //! flights advanced in turn let the core overlap the chains. The ratio of
 //! the two times is what batching paths could gain on the walks, which
-//! are most of a path's time.
+//! take nearly half of a path's time.
 
 use crate::BenchResult;
 use cirrus_bricks::BrickVolume;

@@ -46,11 +46,7 @@ pub fn sample_free_flight<S: Spectrum, M: Media>(
 ) -> FreeFlight {
     let segments = medium.majorants(ray.origin, ray.dir, 0.0, t_max);
     let mut walk = Walk::new(segments, false, rng);
-    loop {
-        if let Some(flight) = flight_event::<S, _, _>(medium, ray, &mut walk, beta, rng, c) {
-            return flight;
-        }
-    }
+    finish_flight::<S, _, _>(medium, ray, &mut walk, beta, rng, c)
 }
 
 /// Two free flights at once, as [`sample_free_flight`] samples each: their
@@ -59,9 +55,10 @@ pub fn sample_free_flight<S: Spectrum, M: Media>(
 /// ends exactly where it would alone; what changes is that an out-of-order
 /// core overlaps the two flights' chains of dependent steps.
 ///
-/// Two hand-paired walks is the most this pays for: the walk state of
-/// each stays in registers and the loop has no per-lane bookkeeping.
-/// `cirrus bench interleave` measures it against flights one at a time.
+/// Written out for two rather than for N lanes: a loop over arrays of
+/// walks cost more in bookkeeping than the overlap gave (BENCHMARKS.md,
+/// "How busy a core is"). `cirrus bench interleave` measures this pair
+/// against flights one at a time.
 pub fn sample_free_flight_pair<S: Spectrum, M: Media>(
     medium: &M,
     rays: [&Ray; 2],
@@ -83,18 +80,27 @@ pub fn sample_free_flight_pair<S: Spectrum, M: Media>(
     );
     loop {
         if let Some(fa) = flight_event::<S, _, _>(medium, ra, &mut wa, ba, ga, c) {
-            loop {
-                if let Some(fb) = flight_event::<S, _, _>(medium, rb, &mut wb, bb, gb, c) {
-                    return [fa, fb];
-                }
-            }
+            return [fa, finish_flight::<S, _, _>(medium, rb, &mut wb, bb, gb, c)];
         }
         if let Some(fb) = flight_event::<S, _, _>(medium, rb, &mut wb, bb, gb, c) {
-            loop {
-                if let Some(fa) = flight_event::<S, _, _>(medium, ra, &mut wa, ba, ga, c) {
-                    return [fa, fb];
-                }
-            }
+            return [finish_flight::<S, _, _>(medium, ra, &mut wa, ba, ga, c), fb];
+        }
+    }
+}
+
+/// Steps a free flight's walk to where the flight ends.
+#[inline(always)]
+fn finish_flight<S: Spectrum, M: Media, I: Iterator<Item = MajorantSegment>>(
+    medium: &M,
+    ray: &Ray,
+    walk: &mut Walk<I>,
+    beta: &mut Vec3,
+    rng: &mut Rng,
+    c: &mut Counters,
+) -> FreeFlight {
+    loop {
+        if let Some(flight) = flight_event::<S, _, _>(medium, ray, walk, beta, rng, c) {
+            return flight;
         }
     }
 }
