@@ -44,9 +44,7 @@ pub fn sample_free_flight<S: Spectrum, M: Media>(
     rng: &mut Rng,
     c: &mut Counters,
 ) -> FreeFlight {
-    let segments = medium.majorants(ray.origin, ray.dir, 0.0, t_max);
-    let mut walk = Walk::new(segments, false, rng);
-    finish_flight::<S, _, _>(medium, ray, &mut walk, beta, rng, c)
+    Flight::start(medium, ray, t_max, beta, rng).finish::<S, _>(medium, c)
 }
 
 /// Two free flights at once, as [`sample_free_flight`] samples each: their
@@ -68,70 +66,80 @@ pub fn sample_free_flight_pair<S: Spectrum, M: Media>(
     c: &mut Counters,
 ) -> [FreeFlight; 2] {
     let ([ra, rb], [ba, bb], [ga, gb]) = (rays, betas, rngs);
-    let mut wa = Walk::new(
-        medium.majorants(ra.origin, ra.dir, 0.0, t_max[0]),
-        false,
-        ga,
-    );
-    let mut wb = Walk::new(
-        medium.majorants(rb.origin, rb.dir, 0.0, t_max[1]),
-        false,
-        gb,
-    );
+    let mut a = Flight::start(medium, ra, t_max[0], ba, ga);
+    let mut b = Flight::start(medium, rb, t_max[1], bb, gb);
     loop {
-        if let Some(fa) = flight_event::<S, _, _>(medium, ra, &mut wa, ba, ga, c) {
-            return [fa, finish_flight::<S, _, _>(medium, rb, &mut wb, bb, gb, c)];
+        if let Some(fa) = a.event::<S, _>(medium, c) {
+            return [fa, b.finish::<S, _>(medium, c)];
         }
-        if let Some(fb) = flight_event::<S, _, _>(medium, rb, &mut wb, bb, gb, c) {
-            return [finish_flight::<S, _, _>(medium, ra, &mut wa, ba, ga, c), fb];
+        if let Some(fb) = b.event::<S, _>(medium, c) {
+            return [a.finish::<S, _>(medium, c), fb];
         }
     }
 }
 
-/// Steps a free flight's walk to where the flight ends.
-#[inline(always)]
-fn finish_flight<S: Spectrum, M: Media, I: Iterator<Item = MajorantSegment>>(
-    medium: &M,
-    ray: &Ray,
-    walk: &mut Walk<I>,
-    beta: &mut Vec3,
-    rng: &mut Rng,
-    c: &mut Counters,
-) -> FreeFlight {
-    loop {
-        if let Some(flight) = flight_event::<S, _, _>(medium, ray, walk, beta, rng, c) {
-            return flight;
-        }
-    }
+/// A free flight under way: its ray, its majorant walk, its weight and its
+/// generator.
+struct Flight<'a, I> {
+    ray: &'a Ray,
+    walk: Walk<I>,
+    beta: &'a mut Vec3,
+    rng: &'a mut Rng,
 }
 
-/// One event of a free flight's walk, decided by [`Spectrum::collide`]:
-/// where the flight ended, or `None` while it goes on.
-#[inline(always)]
-fn flight_event<S: Spectrum, M: Media, I: Iterator<Item = MajorantSegment>>(
-    medium: &M,
-    ray: &Ray,
-    walk: &mut Walk<I>,
-    beta: &mut Vec3,
-    rng: &mut Rng,
-    c: &mut Counters,
-) -> Option<FreeFlight> {
-    match walk.next(rng, c) {
-        Event::Enter(_) => None,
-        Event::End => Some(FreeFlight::Escaped),
-        Event::Capped => Some(FreeFlight::Capped),
-        Event::Collision { t, segment, .. } => {
-            let extinction = |c: &mut Counters| lookup::<S, M>(medium, ray, t, segment.majorant, c);
-            match S::collide(&segment, beta, rng, c, extinction) {
-                Collision::Real => {
-                    c.real_collisions += 1;
-                    Some(FreeFlight::Collision { t })
+impl<'a, I: Iterator<Item = MajorantSegment>> Flight<'a, I> {
+    /// The flight along `ray` up to `t_max`, its first optical depth drawn.
+    #[inline(always)]
+    fn start<M: Media<Majorants<'a> = I>>(
+        medium: &'a M,
+        ray: &'a Ray,
+        t_max: f32,
+        beta: &'a mut Vec3,
+        rng: &'a mut Rng,
+    ) -> Self {
+        let segments = medium.majorants(ray.origin, ray.dir, 0.0, t_max);
+        let walk = Walk::new(segments, false, rng);
+        Self {
+            ray,
+            walk,
+            beta,
+            rng,
+        }
+    }
+
+    /// Steps the walk to where the flight ends.
+    #[inline(always)]
+    fn finish<S: Spectrum, M: Media>(&mut self, medium: &M, c: &mut Counters) -> FreeFlight {
+        loop {
+            if let Some(flight) = self.event::<S, M>(medium, c) {
+                return flight;
+            }
+        }
+    }
+
+    /// One event of the walk, decided by [`Spectrum::collide`]: where the
+    /// flight ended, or `None` while it goes on.
+    #[inline(always)]
+    fn event<S: Spectrum, M: Media>(&mut self, medium: &M, c: &mut Counters) -> Option<FreeFlight> {
+        match self.walk.next(self.rng, c) {
+            Event::Enter(_) => None,
+            Event::End => Some(FreeFlight::Escaped),
+            Event::Capped => Some(FreeFlight::Capped),
+            Event::Collision { t, segment, .. } => {
+                let ray = self.ray;
+                let extinction =
+                    |c: &mut Counters| lookup::<S, M>(medium, ray, t, segment.majorant, c);
+                match S::collide(&segment, self.beta, self.rng, c, extinction) {
+                    Collision::Real => {
+                        c.real_collisions += 1;
+                        Some(FreeFlight::Collision { t })
+                    }
+                    Collision::Null => {
+                        c.null_collisions += 1;
+                        None
+                    }
+                    Collision::Dead => Some(FreeFlight::Capped),
                 }
-                Collision::Null => {
-                    c.null_collisions += 1;
-                    None
-                }
-                Collision::Dead => Some(FreeFlight::Capped),
             }
         }
     }
