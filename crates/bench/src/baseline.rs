@@ -33,8 +33,9 @@ impl GlobalMajorant {
         t_min: f32,
         t_max: f32,
     ) -> impl Iterator<Item = MajorantSegment> {
-        let (a, b) = Bounds3::new(Vec3::ZERO, self.extent).slab(origin, dir.recip());
-        let (t0, t1) = (a.max(t_min), b.min(t_max));
+        let (t0, t1) = Bounds3::new(Vec3::ZERO, self.extent)
+            .clip_ray(origin, dir, t_min, t_max)
+            .unwrap_or((0.0, 0.0));
         let majorant = self.majorant;
         (t0 < t1 && majorant > 0.0)
             .then_some(MajorantSegment {
@@ -105,9 +106,10 @@ impl FixedMajorantGrid {
     /// Segments cell by cell (Amanatides–Woo), empty cells left out.
     pub fn segments(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> FixedGridIter<'_> {
         let inv = dir.recip();
-        let (a, b) = Bounds3::new(Vec3::ZERO, self.extent).slab(origin, inv);
-        let (t, t_end) = (a.max(t_min), b.min(t_max));
-        let p = origin + dir * t.max(a);
+        let (t, t_end) = Bounds3::new(Vec3::ZERO, self.extent)
+            .clip_ray(origin, dir, t_min, t_max)
+            .unwrap_or((0.0, 0.0));
+        let p = origin + dir * t;
         let cell = (p / self.cell)
             .floor()
             .as_ivec3()

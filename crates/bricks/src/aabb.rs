@@ -2,11 +2,12 @@
 //! render space) and [`DBounds3`] in `f64` (world space, where volumes far
 //! from the origin keep their precision). Plain `Copy` values, glam style.
 //!
-//! Two ray tests, for two jobs: [`Bounds3::clip_ray`] handles direction
-//! components of zero explicitly (a ray in a slab's plane is inside or
-//! outside by its origin, never `0 * inf = NaN`) and clips to a parameter
-//! range; [`Bounds3::slab`] is the bare slab test of the DDA's start, with the
-//! inverse direction precomputed and NaN dropped by `min`/`max`.
+//! One ray test, [`Bounds3::clip_ray`]: it handles direction components
+//! of zero explicitly (a ray in a slab's plane is inside or outside by its
+//! origin, never `0 * inf = NaN`) and clips to a parameter range. There is
+//! deliberately no bare slab test with a precomputed `1 / dir`: glam's
+//! `min`/`max` are ordered compares that keep a NaN in one operand, so
+//! such a test can return an infinite or NaN end for a ray along a face.
 
 use glam::{DMat4, DVec3, Vec3};
 
@@ -101,16 +102,6 @@ impl Bounds3 {
         }
         (t0 <= t1).then_some((t0, t1))
     }
-
-    /// Slab test with the inverse direction given: the parameter interval
-    /// inside, empty when `t0 > t1`. NaN (`0 * inf` for a ray on a slab
-    /// face) is dropped by `min`/`max`.
-    #[inline]
-    pub fn slab(&self, origin: Vec3, inv_dir: Vec3) -> (f32, f32) {
-        let a = (self.min - origin) * inv_dir;
-        let b = (self.max - origin) * inv_dir;
-        (a.min(b).max_element(), a.max(b).min_element())
-    }
 }
 
 impl DBounds3 {
@@ -192,7 +183,7 @@ mod tests {
     }
 
     #[test]
-    fn the_two_ray_tests_agree_off_the_faces_and_clip_handles_them() {
+    fn clip_agrees_with_an_f64_slab_test_off_the_faces_and_handles_them() {
         let b = Bounds3::new(Vec3::ZERO, Vec3::splat(2.0));
         let mut s = 1u64;
         let mut rnd = || {
@@ -204,7 +195,15 @@ mod tests {
         for _ in 0..2000 {
             let o = Vec3::new(rnd(), rnd(), rnd());
             let d = Vec3::new(rnd(), rnd(), rnd());
-            let (a0, a1) = b.slab(o, d.recip());
+            // The slab test in f64, whose direction has no zero here.
+            let (lo, hi) = (
+                (b.min.as_dvec3() - o.as_dvec3()) / d.as_dvec3(),
+                (b.max.as_dvec3() - o.as_dvec3()) / d.as_dvec3(),
+            );
+            let (a0, a1) = (
+                lo.min(hi).max_element() as f32,
+                lo.max(hi).min_element() as f32,
+            );
             let clipped = b.clip_ray(o, d, f32::NEG_INFINITY, f32::INFINITY);
             match clipped {
                 Some((c0, c1)) => assert!((c0 - a0).abs() < 1e-5 && (c1 - a1).abs() < 1e-5),
@@ -218,6 +217,18 @@ mod tests {
             b.clip_ray(Vec3::new(-0.5, 1.0, -1.0), Vec3::Z, 0.0, 10.0),
             None
         );
+        // On a face, with a zero (or negative zero) component: inside,
+        // with a finite end whatever the face.
+        for o in [Vec3::new(0.0, 1.0, 1.0), Vec3::new(2.0, 1.0, 1.0)] {
+            for d in [
+                Vec3::Y,
+                Vec3::new(-0.0, 1.0, 0.0),
+                Vec3::new(0.0, -1.0, -0.0),
+            ] {
+                let (t0, t1) = b.clip_ray(o, d, 0.0, f32::INFINITY).unwrap();
+                assert_eq!((t0, t1), (0.0, 1.0), "{o} {d}");
+            }
+        }
         // Restricted to [t_min, t_max].
         assert_eq!(
             b.clip_ray(Vec3::new(1.0, 1.0, -1.0), Vec3::Z, 1.5, 2.0),

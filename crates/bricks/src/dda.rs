@@ -76,18 +76,26 @@ pub(crate) struct CellRay {
 
 impl CellRay {
     /// The ray clipped to the volume's box and to `[t_min, t_max]`; a ray
-    /// with a non-finite or zero direction is empty.
+    /// with a non-finite or zero direction is empty, and so is one whose
+    /// exit from the box is not finite (a direction too small to leave
+    /// it), so every walk has a finite length to cross.
+    ///
+    /// The clip treats a zero direction component as lying in its slab
+    /// or not by the origin alone ([`Bounds3::clip_ray`]): a slab test
+    /// with `1 / 0 = inf` gives `0 * inf = NaN` for an origin on one of
+    /// that axis's faces, which an ordered `min`/`max` can carry into the
+    /// ray's end, and a walk toward `t = inf` takes ~1e8 steps.
     pub fn new(volume: &BrickVolume, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
-        let inv_dir = dir.recip();
-        let (b0, b1) = Bounds3::new(Vec3::ZERO, volume.local_extent()).slab(origin, inv_dir);
         // For exits: a zero component never exits (+inf, whatever the sign of zero).
-        let inv_dir = Vec3::select(dir.cmpeq(Vec3::ZERO), Vec3::INFINITY, inv_dir);
+        let inv_dir = Vec3::select(dir.cmpeq(Vec3::ZERO), Vec3::INFINITY, dir.recip());
         let valid = origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO;
-        let (t, t_end) = if valid {
-            (t_min.max(b0), t_max.min(b1))
-        } else {
-            (0.0, 0.0)
-        };
+        let clipped = valid
+            .then(|| {
+                Bounds3::new(Vec3::ZERO, volume.local_extent()).clip_ray(origin, dir, t_min, t_max)
+            })
+            .flatten()
+            .filter(|&(t0, t1)| t0.is_finite() && t1.is_finite());
+        let (t, t_end) = clipped.unwrap_or((0.0, 0.0));
         CellRay {
             origin: origin.into(),
             dir: dir.into(),
@@ -120,16 +128,30 @@ impl CellRay {
     pub fn leave(&mut self, lo: Vec3A, hi: Vec3A, nudge: f32) -> f32 {
         let far = Vec3A::select(self.upward, hi, lo);
         let exits = (far - self.origin) * self.inv_dir;
-        // An axis the ray never crosses, from a point on one of its faces,
-        // gives 0 x inf = NaN: it bounds nothing (as `f32::min` would skip it).
-        let exit = Vec3A::select(exits.is_nan_mask(), Vec3A::INFINITY, exits).min_element();
         let t0 = self.t;
-        // `exit` is never NaN (NaN lanes were dropped), nor are the ray's
-        // ends, so plain compares give `exit.max(..).min(t_end)` without
-        // the NaN fix-ups `f32::max` and `min` compile to, a few cycles on
-        // the step's critical path.
+        // Only an exit ahead of the walk bounds the step. An axis the ray
+        // never crosses, from a point on one of its faces, gives
+        // 0 x inf = NaN. An axis the ray creeps along (a component of
+        // 1e-7 beside 1) gives an exit at or behind `t0` when its
+        // coordinate rounds onto the cell's far face: the points the
+        // lookups see stay in this cell until the rounding moves them, so
+        // that axis does not end the step, and the walk goes on to the
+        // next face it does cross rather than creep by the nudge (which
+        // took ~1e5 steps per cell). NaN compares false, so one mask
+        // drops both.
+        let ahead = exits.cmpgt(Vec3A::splat(t0));
+        let exit = Vec3A::select(ahead, exits, Vec3A::INFINITY).min_element();
+        // `exit` is never NaN, nor are the ray's ends, so plain compares
+        // give `exit.max(..).min(t_end)` without the NaN fix-ups
+        // `f32::max` and `min` compile to, a few cycles on the step's
+        // critical path. No exit ahead at all (only by rounding on the
+        // major axis) still moves the walk by the nudge.
         let least = t0 + nudge;
-        let t = if exit > least { exit } else { least };
+        let t = if exit > least && exit < f32::INFINITY {
+            exit
+        } else {
+            least
+        };
         self.t = if t < self.t_end { t } else { self.t_end };
         t0
     }
