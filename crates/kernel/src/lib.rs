@@ -71,6 +71,7 @@ pub use integrator::{
 };
 pub use light::{
     AreaLight, AreaShape, Environment, Light, LightKind, Lights, SphereLight, Spot, Sun,
+    MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE,
 };
 pub use medium::{
     Bounds3, BrickField, DensityField, Emission, Extinction, GlobalMedia, Interaction,

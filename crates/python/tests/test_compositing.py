@@ -158,3 +158,31 @@ def test_denoised_layers_read_back_and_make_up_the_blend(tmp_path):
     # Both images take part somewhere, and the denoiser did change the image.
     assert (w < 0.5).any() and (w > 0.5).any()
     assert np.abs(plain - noisy).max() > 1e-3
+
+
+def test_light_groups_named_outside_latin1_read_back_by_openexr(tmp_path):
+    """A light group named in Japanese (or any UTF-8) is written as
+    OpenEXR's own library reads names, and its layer still sums with the
+    others to the beauty; a name past OpenEXR's 255-byte channel names is
+    refused by name before the render."""
+    scene = {
+        "camera": {"res": "24x16"},
+        "render": {"spp": 4, "seed": 5},
+        "volume": [{"file": str(CLOUD)}],
+        "environment": {"radiance": [0.2, 0.2, 0.25]},
+        "light": [{"type": "sphere", "name": "ランプ", "position": [0.0, 300.0, 0.0],
+                   "intensity": 1000.0, "radius": 10.0}],
+    }
+    out = tmp_path / "unicode.exr"
+    image, _ = cirrus.render(scene, output=out, light_groups=True)
+    _, channels = read_exr(out)
+    assert "ランプ.R" in channels, sorted(channels)
+    lamp = np.stack([channels[f"ランプ.{c}"] for c in "RGB"], axis=-1)
+    sky = np.stack([channels[f"sky.{c}"] for c in "RGB"], axis=-1)
+    assert lamp.max() > 0.0
+    beauty = np.stack([channels[c] for c in "RGB"], axis=-1)
+    assert np.all(np.abs(lamp + sky - beauty) <= 1e-5 * np.maximum(beauty, 1e-3) + 1e-6)
+    scene["light"][0]["name"] = "x" * 254
+    with pytest.raises(ValueError, match="254 bytes"):
+        cirrus.render(scene, output=tmp_path / "long.exr", light_groups=True)
+    assert not (tmp_path / "long.exr").exists()

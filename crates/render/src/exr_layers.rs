@@ -156,21 +156,16 @@ fn write_channels(
     use exr::prelude::*;
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
         .into_iter()
-        .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v)))
+        .map(|(name, v)| AnyChannel::new(utf8_text(&name), FlatSamples::F32(v)))
         .collect();
     let mut layer_attributes = LayerAttributes {
         layer_position: Vec2(position.0, position.1),
         ..LayerAttributes::default()
     };
     for (name, value) in attributes {
-        let text = |s: &str| {
-            Text::new_or_none(s).ok_or_else(|| {
-                std::io::Error::other(format!("attribute {name}: not storable as EXR text"))
-            })
-        };
         layer_attributes
             .other
-            .insert(text(&name)?, AttributeValue::Text(text(&value)?));
+            .insert(utf8_text(&name), AttributeValue::Text(utf8_text(&value)));
     }
     let layer = Layer::new(
         Vec2(size.0, size.1),
@@ -188,6 +183,15 @@ fn write_channels(
             .to_buffered(std::io::BufWriter::new(file))
             .map_err(|e| std::io::Error::other(e.to_string()))
     })
+}
+
+/// `s` as EXR text in UTF-8, as OpenEXR's own library writes and reads
+/// names (the exr crate's `From<&str>` takes Latin-1 alone and panics on
+/// anything else, a light group named in Japanese say). Names are
+/// checked for OpenEXR's 255-byte limit where they are made
+/// ([`crate::compositing::Compositing::validate`]).
+fn utf8_text(s: &str) -> exr::prelude::Text {
+    exr::prelude::Text::from_slice_unchecked(s.as_bytes())
 }
 
 /// Assembles crop tiles into one full-size EXR. The tiles must share the

@@ -42,7 +42,7 @@ pub fn read_channels(path: &Path) -> Result<ExrChannels> {
         .other
         .iter()
         .filter_map(|(k, v)| match v {
-            AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
+            AttributeValue::Text(t) => Some((utf8(k), utf8(t))),
             _ => None,
         })
         .collect();
@@ -63,7 +63,7 @@ pub fn read_channels(path: &Path) -> Result<ExrChannels> {
                 FlatSamples::F16(v) => v.into_iter().map(|h| h.to_f32()).collect(),
                 FlatSamples::U32(v) => v.into_iter().map(|u| u as f32).collect(),
             };
-            (c.name.to_string(), v)
+            (utf8(&c.name), v)
         })
         .collect();
     Ok(ExrChannels {
@@ -106,4 +106,11 @@ pub(crate) fn exr_error(path: &Path, e: exr::error::Error) -> Error {
         exr::error::Error::Io(source) => Error::io(path, source),
         other => Error::format(path, other),
     }
+}
+
+/// A name or text of the file as UTF-8, which OpenEXR's own library and
+/// the files written here use (the exr crate's own reading of it is
+/// Latin-1).
+fn utf8(t: &exr::prelude::Text) -> String {
+    String::from_utf8_lossy(t.bytes()).into_owned()
 }

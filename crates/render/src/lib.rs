@@ -55,7 +55,7 @@ pub use cirrus_kernel::{
     GlobalMedia, HenyeyGreenstein, IntegratorKind, Interaction, Light, LightGridSettings,
     LightKind, LightSampling, Lights, MajorantMode, MajorantSegment, Media, Medium, MediumError,
     Phase, Result, SamplerKind, Shutter, SphereLight, Spot, Sun, Sunward, TransmittanceEstimator,
-    Velocity, VelocityUnit, Volumes,
+    Velocity, VelocityUnit, Volumes, MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE,
 };
 #[cfg(feature = "testing")]
 pub use cirrus_kernel::{ConstantBox, GridField, MajorantGrid};

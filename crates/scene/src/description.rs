@@ -169,15 +169,15 @@ declare_settings! {
     res: (u32, u32), serde(default, deserialize_with = "crate::parse::resolution_field"),
         flag(long, value_parser = parse::resolution), default((512, 512)), example((8, 6));
     /// Camera position (world space).
-    camera_from as "from": [f64; 3],
+    camera_from as "from": [f64; 3], serde(default, deserialize_with = "crate::parse::triple_field"),
         flag(long, value_parser = parse::triple, allow_hyphen_values = true, requires = "camera_to"),
         unset("framed on the volumes"), example([400.0, 80.0, 500.0]);
     /// The point the camera looks at (world space).
-    camera_to as "to": [f64; 3],
+    camera_to as "to": [f64; 3], serde(default, deserialize_with = "crate::parse::triple_field"),
         flag(long, value_parser = parse::triple, allow_hyphen_values = true, requires = "camera_from"),
         unset("framed on the volumes"), example([150.0, 80.0, 100.0]);
     /// The camera's up direction.
-    camera_up as "up": [f32; 3], flag(long, value_parser = parse::vector, allow_hyphen_values = true),
+    camera_up as "up": [f32; 3], serde(default, deserialize_with = "crate::parse::triple_field"), flag(long, value_parser = parse::vector, allow_hyphen_values = true),
         default([0.0, 1.0, 0.0]), example([0.0, 0.0, 1.0]);
     /// Vertical field of view in degrees.
     fov: f32, flag(long), default(40.0), example(25.0);
@@ -214,12 +214,12 @@ declare_settings! {
         flag(long = "no-sun", num_args = 0, default_missing_value = "false"),
         default(true), example(false);
     /// Direction the sunlight travels, from the sun toward the scene.
-    sun_dir as "direction": [f32; 3],
+    sun_dir as "direction": [f32; 3], serde(default, deserialize_with = "crate::parse::triple_field"),
         flag(long, value_parser = parse::vector, allow_hyphen_values = true),
         default([0.7, -0.5, 0.5]), example([0.0, -1.0, 0.0]);
     /// Sun irradiance on a surface facing it (W/m^2 per channel, Mitsuba's
     /// `directional`).
-    sun_irradiance as "irradiance": [f32; 3],
+    sun_irradiance as "irradiance": [f32; 3], serde(default, deserialize_with = "crate::parse::triple_field"),
         flag(long, value_parser = parse::vector, allow_hyphen_values = true),
         default([2.6, 2.5, 2.3]), example([1.0, 1.0, 1.0]);
     /// Angular diameter of the sun in degrees (0: a delta light).
@@ -229,7 +229,7 @@ declare_settings! {
     /// `[environment]`: light from every direction, constant or a map.
     table environment: EnvironmentSpec, EnvironmentFlags, optional {
     /// Constant sky radiance (0,0,0 for none); ignored when a map is given.
-    env_radiance as "radiance": [f32; 3],
+    env_radiance as "radiance": [f32; 3], serde(default, deserialize_with = "crate::parse::triple_field"),
         flag(long, value_parser = parse::vector, allow_hyphen_values = true),
         default([0.16, 0.22, 0.34]), example([1.0, 1.0, 1.0]);
     /// A lat-long HDR sky (EXR) instead of the constant radiance (in a
@@ -260,13 +260,13 @@ declare_settings! {
         group: Option<String>;
         /// Where a sphere, point, spot or area light is (an area light's
         /// centre).
-        position: Option<[f32; 3]>;
+        position: Option<[f32; 3]> = serde(default, deserialize_with = "crate::parse::triple_field");
         /// Direction a distant light's light travels, a spot's axis, the
         /// side an area light emits toward, or a cylinder's axis.
-        direction: Option<[f32; 3]>;
+        direction: Option<[f32; 3]> = serde(default, deserialize_with = "crate::parse::triple_field");
         /// An area light's second axis (its height's), turned square to
         /// `direction` (default +Y, or +Z along Y).
-        up: Option<[f32; 3]>;
+        up: Option<[f32; 3]> = serde(default, deserialize_with = "crate::parse::triple_field");
         /// A sphere or spot light's radius (sphere default 0.5, UsdLux's),
         /// or a disk's or cylinder's (default 0.5).
         radius: Option<f32>;
@@ -278,7 +278,7 @@ declare_settings! {
         /// A cylinder's length along its axis (default 1, UsdLux's).
         length: Option<f32>;
         /// Colour, multiplying `intensity` (default 1,1,1).
-        color: Option<[f32; 3]>;
+        color: Option<[f32; 3]> = serde(default, deserialize_with = "crate::parse::triple_field");
         /// The light's strength (default 1), times `2^exposure` and
         /// `color`: a distant light's irradiance (W/m^2, as `[sun]`), a
         /// sphere's or area light's surface radiance (UsdLux; a point's
@@ -364,7 +364,7 @@ declare_settings! {
         /// Emission grid name: `value * emission_color * emission_scale`.
         emission: Option<String>;
         /// The emission grid's colour.
-        emission_color: Option<[f32; 3]>;
+        emission_color: Option<[f32; 3]> = serde(default, deserialize_with = "crate::parse::triple_field");
         /// The emission grid's multiplier.
         emission_scale: Option<f32>;
         /// Object to world: `{ translate, rotate = { axis, degrees } or
@@ -486,6 +486,7 @@ impl SceneDescription {
                 .map_err(|e| format!("volume {} ({}): {e}", i + 1, v.file.display()))?;
         }
         LightSpec::check_all(&self.lights)?;
+        crate::lights::check_shorthands(self)?;
         self.camera.check().map_err(|e| format!("[camera] {e}"))
     }
 }

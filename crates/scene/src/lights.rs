@@ -22,9 +22,10 @@ use std::sync::Arc;
 
 use cirrus_render::compositing::{DEFAULT_LIGHT_GROUPS, MAX_LIGHT_GROUPS};
 use cirrus_render::{AreaLight, AreaShape, Environment, Light, Lights, SphereLight, Spot, Sun};
+use cirrus_render::{MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE};
 use glam::Vec3;
 
-use crate::description::{LightSpec, SceneDescription};
+use crate::description::{EnvironmentSpec, LightSpec, SceneDescription, SunSpec};
 use crate::error::{Error, Result};
 
 /// The angular diameter of a distant light where none is given: the sun's.
@@ -36,6 +37,9 @@ const DEFAULT_SPHERE_RADIUS: f32 = 0.5;
 const DEFAULT_DISK_RADIUS: f32 = 0.5;
 /// A cylinder light's length where none is given (UsdLux's fallback).
 const DEFAULT_CYLINDER_LENGTH: f32 = 1.0;
+/// The smallest radius of a sphere or spot light that is a surface: its
+/// area `4 pi r^2` and radiance stay normal f32 numbers above it.
+const MIN_SURFACE_RADIUS: f32 = 1e-12;
 /// The layer of sphere and spot lights with no name or group.
 const DEFAULT_LOCAL_GROUP: &str = "lights";
 
@@ -137,7 +141,8 @@ impl LightSpec {
             return Err(format!("`{key}` does not apply to a {kind} light"));
         }
         self.check_values()?;
-        self.check_kind()
+        self.check_kind()?;
+        self.check_derived()
     }
 
     /// Every value given finite and in range.
@@ -168,6 +173,11 @@ impl LightSpec {
         }
         if let Some(r) = self.rotation {
             finite("rotation", &[r])?;
+        }
+        if self.map.as_ref().is_some_and(|m| m.as_os_str().is_empty()) {
+            return Err(
+                "`map` is empty: give an EXR file, or leave `map` out for a constant dome".into(),
+            );
         }
         for (key, size) in [
             ("width", self.width),
@@ -231,6 +241,84 @@ impl LightSpec {
                 Ok(())
             }
             _ => Ok(()),
+        }
+    }
+
+    /// The values made from the keys (`intensity * 2^exposure * color`,
+    /// then the light's radiance, area or intensity) within what a
+    /// render's f32 arithmetic carries ([`Light::check_limits`]); a
+    /// dome's map stands in as its multiplier.
+    fn check_derived(&self) -> std::result::Result<(), String> {
+        let strength = self.strength();
+        if !strength.is_finite() || strength.max_element() > MAX_LIGHT_VALUE {
+            return Err(format!(
+                "`intensity` x 2^`exposure` x `color` is {}: past {MAX_LIGHT_VALUE:e}, more than a render's f32 arithmetic can carry",
+                shown(strength)
+            ));
+        }
+        for (key, v) in [
+            ("radius", self.radius),
+            ("width", self.width),
+            ("height", self.height),
+            ("length", self.length),
+        ] {
+            if v.is_some_and(|v| v > MAX_LIGHT_EXTENT) {
+                return Err(format!(
+                    "`{key}` {:e} is past {MAX_LIGHT_EXTENT:e} units, where areas and squared distances overflow f32",
+                    v.unwrap_or_default()
+                ));
+            }
+        }
+        if let Some(p) = self.position.map(Vec3::from_array) {
+            if p.abs().max_element() > MAX_LIGHT_EXTENT {
+                return Err(format!(
+                    "`position` {} is past {MAX_LIGHT_EXTENT:e} units from the origin, where squared distances overflow f32",
+                    shown(p)
+                ));
+            }
+        }
+        let r = self.radius.unwrap_or(0.0);
+        if matches!(self.kind.as_str(), "sphere" | "spot") && r > 0.0 && r < MIN_SURFACE_RADIUS {
+            return Err(format!(
+                "`radius` {r:e} is too small to be a surface in f32 (under {MIN_SURFACE_RADIUS:e}): give `radius = 0`, a point"
+            ));
+        }
+        let light = match self.kind.as_str() {
+            "dome" => Environment::new(strength).into(),
+            _ => self.light().map_err(|e| e.to_string())?,
+        };
+        let keys = self.value_keys();
+        light
+            .check_limits()
+            .map_err(|e| format!("{e} (made from {keys})"))?;
+        if strength.max_element() > 0.0 && light.is_black() {
+            return Err(format!(
+                "it delivers no light in f32: its values ({keys}) underflow to 0"
+            ));
+        }
+        Ok(())
+    }
+
+    /// The keys given that its strength and shape are made from, for
+    /// messages: "`intensity`, `radius`".
+    fn value_keys(&self) -> String {
+        let strength = [
+            ("intensity", self.intensity.is_some()),
+            ("exposure", self.exposure.is_some()),
+            ("color", self.color.is_some()),
+        ];
+        let shape = ["radius", "width", "height", "length", "normalize", "angle"];
+        let keys: Vec<String> = strength
+            .iter()
+            .filter(|k| k.1)
+            .map(|k| k.0)
+            .chain(self.given().into_iter().filter(|k| shape.contains(k)))
+            .map(|k| format!("`{k}`"))
+            .collect();
+        if keys.is_empty() {
+            "its defaults".into()
+        } else {
+            keys.join(", ")
         }
     }
 
@@ -352,28 +440,148 @@ impl LightSpec {
 }
 
 /// The radiant intensity of a sphere of radius `r` whose strength is
-/// `strength`: its radiance (over its area where normalised) times its
-/// projected area `pi r^2`; a point's strength is its intensity.
+/// `strength`: its radiance times its projected area `pi r^2`; where
+/// normalised, its radiance is `strength / (4 pi r^2)`, so its intensity
+/// is `strength / 4` whatever the radius (computed so: the product of the
+/// two would be `inf x 0` for a tiny radius). A point's strength is its
+/// intensity.
 fn intensity(strength: Vec3, r: f32, spec: &LightSpec) -> Vec3 {
     if r <= 0.0 {
-        return strength;
-    }
-    let radiance = if spec.normalize.unwrap_or(false) {
-        strength / (4.0 * PI * r * r)
-    } else {
         strength
+    } else if spec.normalize.unwrap_or(false) {
+        0.25 * strength
+    } else {
+        strength * (PI * r * r)
+    }
+}
+
+/// `v` as a person writes it in a message: `[3.400e41, 0, 1]`.
+pub(crate) fn shown(v: Vec3) -> String {
+    let n = |x: f32| {
+        if x != 0.0 && x.is_finite() && (x.abs() >= 1e6 || x.abs() < 1e-4) {
+            format!("{x:.3e}")
+        } else {
+            format!("{x}")
+        }
     };
-    radiance * (PI * r * r)
+    format!("[{}, {}, {}]", n(v.x), n(v.y), n(v.z))
+}
+
+impl SunSpec {
+    /// The `[sun]` table's (or its flags') values, as a distant light's
+    /// are checked: a finite, non-zero direction, an irradiance finite,
+    /// at least 0 and within what a render carries, an angle in [0, 180]
+    /// degrees.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        let dir = Vec3::from_array(self.sun_dir());
+        if !dir.is_finite() || dir.length_squared() == 0.0 {
+            return Err(format!(
+                "[sun] direction {} must be finite and not zero",
+                shown(dir)
+            ));
+        }
+        let e = Vec3::from_array(self.sun_irradiance());
+        if !e.is_finite() || e.min_element() < 0.0 {
+            return Err(format!(
+                "[sun] irradiance {} must be finite and at least 0",
+                shown(e)
+            ));
+        }
+        let angle = self.sun_angle();
+        if !(0.0..=180.0).contains(&angle) {
+            return Err(format!("[sun] angle {angle} is not in [0, 180] degrees"));
+        }
+        Light::from(Sun::new(dir, e, angle.to_radians()))
+            .check_limits()
+            .map_err(|e| format!("[sun] {e}"))
+    }
+}
+
+impl EnvironmentSpec {
+    /// The `[environment]` table's (or its flags') values: a radiance and
+    /// a map's intensity finite, at least 0 and within what a render
+    /// carries, a finite rotation.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        let l = Vec3::from_array(self.env_radiance());
+        if !l.is_finite() || l.min_element() < 0.0 {
+            return Err(format!(
+                "[environment] radiance {} must be finite and at least 0",
+                shown(l)
+            ));
+        }
+        let k = self.env_intensity();
+        if !k.is_finite() || k < 0.0 {
+            return Err(format!(
+                "[environment] intensity {k} must be finite and at least 0"
+            ));
+        }
+        if self
+            .env_map
+            .as_ref()
+            .is_some_and(|m| m.as_os_str().is_empty())
+        {
+            return Err("[environment] map is empty: give an EXR file, or leave `map` out".into());
+        }
+        let r = self.env_rotation();
+        if !r.is_finite() {
+            return Err(format!("[environment] rotation {r} is not finite"));
+        }
+        for v in [l, Vec3::splat(k)] {
+            Light::from(Environment::new(v))
+                .check_limits()
+                .map_err(|e| format!("[environment] {e}"))?;
+        }
+        Ok(())
+    }
+}
+
+/// Checks that every sky map a description names (`[environment] map`,
+/// a dome's `map`) is a file that exists, naming the table or light and
+/// the key: read later, when the render starts, its error would name only
+/// the map.
+pub(crate) fn check_maps(desc: &SceneDescription) -> Result<()> {
+    let env = desc.environment.as_ref().and_then(|e| e.env_map.as_deref());
+    let lights = desc
+        .lights
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| Some((format!("{}: `map`", l.label(i)), l.map.as_deref()?)));
+    for (what, path) in env
+        .map(|p| ("[environment] map".to_string(), p))
+        .into_iter()
+        .chain(lights)
+    {
+        let why = match std::fs::metadata(path) {
+            Err(e) => e.to_string(),
+            Ok(m) if m.is_dir() => "a directory, not an EXR file".into(),
+            Ok(_) => continue,
+        };
+        return Err(Error::file(format!("{what} {}: {why}", path.display())));
+    }
+    Ok(())
+}
+
+/// Checks the `[sun]` and `[environment]` tables a description has.
+pub(crate) fn check_shorthands(desc: &SceneDescription) -> std::result::Result<(), String> {
+    if let Some(sun) = desc.sun.as_ref().filter(|s| s.sun()) {
+        sun.check()?;
+    }
+    if let Some(env) = &desc.environment {
+        env.check()?;
+    }
+    Ok(())
 }
 
 /// The light-group layers of `desc`: `sun`, `sky` and `emission`, then
-/// each other group its lights name, in order.
+/// each other group its lights name, in order; more than the film keeps
+/// is an error (asked for where light groups are written).
 pub fn light_group_names(desc: &SceneDescription) -> Result<Vec<String>> {
     group_names(&desc.lights).map_err(Error::input)
 }
 
-/// [`light_group_names`] of `lights`; more than the film keeps is an error.
-fn group_names(lights: &[LightSpec]) -> std::result::Result<Vec<String>, String> {
+/// Each light's group name, in the layers' order (`sun`, `sky`,
+/// `emission`, then as the lights name them), however many.
+fn all_group_names(lights: &[LightSpec]) -> Vec<String> {
     let mut names: Vec<String> = DEFAULT_LIGHT_GROUPS.iter().map(|s| s.to_string()).collect();
     for spec in lights {
         let g = spec.group_name();
@@ -381,14 +589,34 @@ fn group_names(lights: &[LightSpec]) -> std::result::Result<Vec<String>, String>
             names.push(g.to_string());
         }
     }
+    names
+}
+
+/// [`light_group_names`] of `lights`; more than the film keeps is an
+/// error, its list cut after a few names.
+fn group_names(lights: &[LightSpec]) -> std::result::Result<Vec<String>, String> {
+    let names = all_group_names(lights);
     if names.len() > MAX_LIGHT_GROUPS {
         return Err(format!(
             "{} light groups ({}); at most {MAX_LIGHT_GROUPS}: give lights a shared `group`",
             names.len(),
-            names.join(", ")
+            listed(&names, 10)
         ));
     }
     Ok(names)
+}
+
+/// The first `most` names joined, then how many more: "a, b, ... and 9990
+/// more".
+pub(crate) fn listed(names: &[String], most: usize) -> String {
+    if names.len() <= most {
+        return names.join(", ");
+    }
+    format!(
+        "{}, ... and {} more",
+        names[..most].join(", "),
+        names.len() - most
+    )
 }
 
 /// The lights of `desc`, each tagged with its light group's index in
@@ -396,7 +624,19 @@ fn group_names(lights: &[LightSpec]) -> std::result::Result<Vec<String>, String>
 /// sun and sky are there unless switched off; with any, only where their
 /// tables (or flags) are given.
 pub fn lights(desc: &SceneDescription) -> Result<Lights> {
-    let names = light_group_names(desc)?;
+    check_shorthands(desc).map_err(Error::input)?;
+    // The groups tag each light's contributions; where there are more than
+    // the film keeps (which only matters where light groups are written,
+    // and is refused there), lights are tagged by their kind's layer.
+    let names = match group_names(&desc.lights) {
+        Ok(names) => names,
+        Err(_) => DEFAULT_LIGHT_GROUPS.iter().map(|s| s.to_string()).collect(),
+    };
+    let kind_layer = |spec: &LightSpec| match spec.kind.as_str() {
+        "distant" => DEFAULT_LIGHT_GROUPS[0],
+        "dome" => DEFAULT_LIGHT_GROUPS[1],
+        _ => DEFAULT_LIGHT_GROUPS[0],
+    };
     let index = |g: &str| names.iter().position(|n| n == g).unwrap_or(0) as u8;
     let shorthand = desc.lights.is_empty();
     let mut list: Vec<(Light, u8)> = Vec::new();
@@ -427,20 +667,25 @@ pub fn lights(desc: &SceneDescription) -> Result<Lights> {
         list.push((light.into(), index(DEFAULT_LIGHT_GROUPS[1])));
     }
     for spec in &desc.lights {
-        list.push((spec.light()?, index(spec.group_name())));
+        let group = if names.iter().any(|n| n == spec.group_name()) {
+            spec.group_name()
+        } else {
+            kind_layer(spec)
+        };
+        list.push((spec.light()?, index(group)));
     }
     Ok(Lights::grouped(list, index(DEFAULT_LIGHT_GROUPS[2])).pruned())
 }
 
 impl LightSpec {
-    /// Checks every `[[light]]` of a description, naming the light, and
-    /// that their light groups fit the film.
+    /// Checks every `[[light]]` of a description, naming the light. (Their
+    /// light groups are checked where they are written.)
     pub fn check_all(lights: &[LightSpec]) -> std::result::Result<(), String> {
         for (i, spec) in lights.iter().enumerate() {
             spec.check()
                 .map_err(|e| format!("{}: {e}", spec.label(i)))?;
         }
-        group_names(lights).map(|_| ())
+        Ok(())
     }
 
     /// Each dome map's path relative to `dir`, as a scene file's are.

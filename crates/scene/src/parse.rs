@@ -75,6 +75,21 @@ pub fn resolution_field<'de, D: serde::Deserializer<'de>>(
     resolution(&s).map(Some).map_err(serde::de::Error::custom)
 }
 
+/// A 3-vector field of a scene file or a JSON dict: exactly three
+/// numbers. (Serde reads an array `[T; 3]` as the first three elements
+/// of a list and drops the rest, so `[1, 2, 3, 4]` would pass unseen.)
+pub fn triple_field<'de, D, T>(d: D) -> Result<Option<[T; 3]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: serde::Deserialize<'de>,
+{
+    let v = <Vec<T> as serde::Deserialize>::deserialize(d)?;
+    let n = v.len();
+    <[T; 3]>::try_from(v)
+        .map(Some)
+        .map_err(|_| serde::de::Error::custom(format!("expected 3 numbers, got {n}")))
+}
+
 /// "x0,y0,x1,y1" in pixels.
 pub fn crop(s: &str) -> Result<[u32; 4], String> {
     let v: Vec<u32> = s

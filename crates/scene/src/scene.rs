@@ -76,6 +76,7 @@ impl Scene {
             return Err(Error::input("no [[volume]] in the scene"));
         }
         description.rebase(dir);
+        crate::lights::check_maps(&description)?;
         crate::compositing::instance_names(&description)?;
         description.hold_file_samples();
         Ok(Scene {
@@ -119,6 +120,30 @@ impl Scene {
         self.render_cached(&mut VolumeCache::default(), control)
     }
 
+    /// What to tell the user about a finished render: samples it dropped
+    /// as NaN or infinite (each counted, none written), and an image
+    /// with no light in it at all.
+    pub fn render_warnings(rendered: &Rendered) -> Vec<String> {
+        let c = &rendered.stats.counters;
+        let mut out = Vec::new();
+        if c.nonfinite_samples > 0 {
+            out.push(format!(
+                "{} of {} samples were NaN or infinite and were dropped: the image is darker \
+                 where they fell",
+                c.nonfinite_samples, c.paths
+            ));
+        }
+        let rgba = &rendered.image.rgba;
+        if !rgba.is_empty() && rgba.iter().all(|p| p[..3] == [0.0; 3]) {
+            out.push(
+                "the image is black: no light reaches the camera (are the lights pointed at \
+                 the volumes, and bright enough?)"
+                    .into(),
+            );
+        }
+        out
+    }
+
     /// [`Scene::render_with`] reading files and grids through `cache`,
     /// which keeps them for the next render (a preview's passes).
     pub fn render_cached(
@@ -130,6 +155,7 @@ impl Scene {
         if control.as_ref().is_some_and(|c| c.is_cancelled()) {
             return Err(Error::cancelled());
         }
+        refuse_all_dropped(&rendered.stats.counters)?;
         if self.description.render.denoise.unwrap_or(false) {
             crate::denoise::denoise(&mut rendered)?;
         }
@@ -195,4 +221,38 @@ fn parent(path: &Path) -> &Path {
     path.parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."))
+}
+
+/// An error where every sample of a render was dropped as NaN or
+/// infinite: its image would be black, not a picture of the scene.
+fn refuse_all_dropped(c: &cirrus_render::Counters) -> Result<()> {
+    if c.paths > 0 && c.nonfinite_samples >= c.paths {
+        return Err(Error::input(format!(
+            "every one of the {} samples was NaN or infinite and was dropped, so the image \
+             would be black: the lights' or the media's values overflow (they are counted \
+             as nonfinite_samples in --stats)",
+            c.nonfinite_samples
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod dropped_samples_tests {
+    use super::*;
+
+    #[test]
+    fn a_render_fails_only_when_every_sample_was_dropped() {
+        let mut c = cirrus_render::Counters {
+            paths: 1024,
+            nonfinite_samples: 1023,
+            ..Default::default()
+        };
+        assert!(refuse_all_dropped(&c).is_ok());
+        c.nonfinite_samples = 1024;
+        let e = refuse_all_dropped(&c).unwrap_err().to_string();
+        assert!(e.contains("every one of the 1024 samples"), "{e}");
+        // No paths (an empty crop): nothing to refuse.
+        assert!(refuse_all_dropped(&cirrus_render::Counters::default()).is_ok());
+    }
 }

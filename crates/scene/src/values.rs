@@ -60,11 +60,13 @@ impl std::fmt::Display for Colour {
 #[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TransformSpec {
+    #[serde(default, deserialize_with = "crate::parse::triple_field")]
     pub translate: Option<[f64; 3]>,
     /// Axis-angle rotation.
     pub rotate: Option<AxisAngle>,
     /// Euler angles in degrees, applied about X, then Y, then Z
     /// (exclusive with `rotate`).
+    #[serde(default, deserialize_with = "crate::parse::triple_field")]
     pub euler: Option<[f64; 3]>,
     /// Uniform (a number) or per axis.
     pub scale: Option<ScaleSpec>,

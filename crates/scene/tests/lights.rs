@@ -213,11 +213,111 @@ fn bad_lights_are_errors_naming_the_file_and_the_light() {
     let many: String = (0..6)
         .map(|i| format!("[[light]]\ntype = \"point\"\nname = \"l{i}\"\nposition = [0, 0, 0]\n"))
         .collect();
-    let e = error_of(&format!("[[volume]]\nfile = {:?}\n{many}", cloud()));
+    // More named lights than light-group layers render where no groups
+    // are written, and are refused where they are.
+    let mut s = scene(&many);
+    s.apply(&Overrides {
+        res: Some((8, 8)),
+        spp: Some(1),
+        ..Default::default()
+    });
+    assert!(s.render().is_ok());
+    s.apply(&Overrides {
+        light_groups: Some(true),
+        ..Default::default()
+    });
+    let e = s.render().map(drop).unwrap_err().to_string();
     assert!(
         e.contains("9 light groups") && e.contains("shared `group`"),
         "{e}"
     );
+    // A long list of names is cut with a count.
+    let lots: String = (0..10_000)
+        .map(|i| format!("[[light]]\ntype = \"point\"\nname = \"n{i}\"\nposition = [0, 0, 0]\n"))
+        .collect();
+    let mut s = scene(&lots);
+    s.apply(&Overrides {
+        light_groups: Some(true),
+        ..Default::default()
+    });
+    let e = s.render().map(drop).unwrap_err().to_string();
+    assert!(
+        e.contains("10003 light groups") && e.contains("and 9993 more"),
+        "{e}"
+    );
+    assert!(e.len() < 400, "{} bytes", e.len());
+}
+
+/// Values each fine alone that overflow f32 together, or past what a
+/// render can carry, and the shorthand tables' values: each refused
+/// naming the file, the light or table, and the key.
+#[test]
+fn light_values_that_overflow_f32_are_refused_by_key() {
+    for (body, says) in [
+        ("type = \"dome\"\nexposure = 128", "`intensity` x 2^`exposure` x `color` is [inf"),
+        ("type = \"dome\"\nintensity = 1e38\nexposure = 10", "past 1e30"),
+        ("type = \"distant\"\ndirection = [0, -1, 0]\nintensity = 1e38", "past 1e30"),
+        (
+            "type = \"distant\"\ndirection = [0, -1, 0]\nintensity = 1e29\nangle = 0.01",
+            "radiance (irradiance over the disc's solid angle)",
+        ),
+        (
+            "type = \"sphere\"\nposition = [0, 0, 0]\nradius = 1e-25\nnormalize = true",
+            "`radius` 1e-25 is too small",
+        ),
+        ("type = \"sphere\"\nposition = [0, 0, 0]\nradius = 1e19", "`radius` 1e19 is past 1e12"),
+        ("type = \"point\"\nposition = [1e20, 0, 0]", "`position` [1.000e20, 0, 0] is past 1e12"),
+        (
+            "type = \"rect\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\nwidth = 1e-30\nheight = 1e-30\nnormalize = true",
+            "not positive in f32",
+        ),
+        ("type = \"point\"\nposition = [1, 2, 3, 4]", "expected 3 numbers, got 4"),
+        ("type = \"point\"\nposition = [1, 2]", "expected 3 numbers, got 2"),
+        ("type = \"dome\"\nmap = \"\"", "`map` is empty"),
+    ] {
+        let e = error_of(&format!("[[light]]\nname = \"hot\"\n{body}\n"));
+        assert!(e.contains("bad.toml"), "{e}");
+        assert!(e.contains(says), "{e} (expected {says:?})");
+        if !says.starts_with("expected") {
+            assert!(e.contains("light 1 (\"hot\")"), "{e}");
+        }
+    }
+    for (body, says) in [
+        (
+            "[sun]\ndirection = [0, 0, 0]",
+            "[sun] direction [0, 0, 0] must be finite and not zero",
+        ),
+        (
+            "[sun]\nirradiance = [-1, 1, 1]",
+            "[sun] irradiance [-1, 1, 1] must be finite and at least 0",
+        ),
+        (
+            "[environment]\nrotation = nan",
+            "[environment] rotation NaN is not finite",
+        ),
+        (
+            "[environment]\nradiance = [nan, 0, 0]",
+            "[environment] radiance [NaN, 0, 0]",
+        ),
+        (
+            "[environment]\nradiance = [1e31, 0, 0]",
+            "[environment] its mean radiance",
+        ),
+    ] {
+        let e = error_of(&format!("{body}\n"));
+        assert!(
+            e.contains("bad.toml") && e.contains(says),
+            "{e} (expected {says:?})"
+        );
+    }
+    // Within the limits, a normalised ball of any radius sends strength / 4.
+    let lights = lights_of(
+        "[[light]]\ntype = \"sphere\"\nposition = [0, 0, 0]\nradius = 1e-6\nintensity = 8\nnormalize = true\n",
+    );
+    let Light::Sphere(s) = &lights[0] else {
+        panic!()
+    };
+    assert!((s.intensity() - Vec3::splat(2.0)).abs().max_element() < 1e-6);
 }
 
 #[test]

@@ -503,3 +503,68 @@ fn a_cylinder_light_lies_along_its_x_axis_and_renders() {
     let mean: f32 = out.image.rgba.iter().map(|p| p[0]).sum::<f32>() / out.image.rgba.len() as f32;
     assert!(mean > 0.0, "the tube lights the cloud");
 }
+
+#[test]
+fn lights_under_an_invisible_parent_are_not_read() {
+    let d = dir("invisible");
+    let body = format!(
+        r#"{}
+    def Xform "Hidden"
+    {{
+        token visibility = "invisible"
+        def SphereLight "Behind" {{ float inputs:intensity = 5 }}
+        def Xform "Deeper" {{ def RectLight "Under" {{ float inputs:intensity = 5 }} }}
+    }}
+    def Xform "Shown"
+    {{
+        def SphereLight "Lamp" {{ float inputs:intensity = 5 }}
+    }}
+"#,
+        volume("Cloud", "./cloud.vdb", "density")
+    );
+    let p = write(&d, "hidden.usda", &stage(&body));
+    let scene = Scene::load(&p).unwrap();
+    let names: Vec<_> = scene
+        .description()
+        .lights
+        .iter()
+        .map(|l| l.name.clone().unwrap_or_default())
+        .collect();
+    assert_eq!(names, ["Lamp"]);
+}
+
+#[test]
+fn light_values_past_f32_are_refused_naming_the_stage_prim_and_value() {
+    let d = dir("f32_lights");
+    let cases = [
+        // Finite doubles that are infinite in f32.
+        ("def SphereLight \"Hot\" { double inputs:intensity = 1e300 }", "/World/Hot", "inf"),
+        ("def DomeLight \"Sky\" { float inputs:intensity = 1e39 }", "/World/Sky", "inf"),
+        (
+            "def SphereLight \"Far\" { double3 xformOp:translate = (1e300, 0, 0)\n uniform token[] xformOpOrder = [\"xformOp:translate\"] }",
+            "/World/Far",
+            "position",
+        ),
+        // A NaN read as a person writes it, not as a debug form.
+        ("def SphereLight \"Nan\" { float inputs:intensity = nan }", "/World/Nan", "got nan"),
+        (
+            "def SphereLight \"Neg\" { float inputs:intensity = -1e38 }",
+            "/World/Neg",
+            "-1e38",
+        ),
+    ];
+    for (k, (light, prim, says)) in cases.iter().enumerate() {
+        let body = format!("{}\n{light}\n", volume("Cloud", "./cloud.vdb", "density"));
+        let name = format!("case{k}.usda");
+        let p = write(&d, &name, &stage(&body));
+        let e = Scene::load(&p).map(drop).unwrap_err().to_string();
+        assert!(
+            e.contains(&name) && e.contains(prim) && e.contains(says),
+            "{light}: {e}"
+        );
+        assert!(
+            !e.contains("Float(") && !e.contains("Vec3") && !e.contains("000000000000"),
+            "{e}"
+        );
+    }
+}

@@ -107,6 +107,9 @@ fn render_one(scene: &Scene, bar: bool) -> Result<PathBuf, Box<dyn std::error::E
     let mut scene = scene.clone();
     scene.progress_bar = bar;
     let rendered = scene.render()?;
+    for warning in Scene::render_warnings(&rendered) {
+        eprintln!("cirrus: warning: {warning}");
+    }
     if rendered.stats.volumes_culled > 0 {
         eprintln!(
             "{} volume(s) neither the camera nor the lights can reach: not loaded",

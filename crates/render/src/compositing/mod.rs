@@ -33,6 +33,10 @@ pub use cirrus_kernel::light::{GroupRadiance, DEFAULT_LIGHT_GROUPS, MAX_LIGHT_GR
 
 use std::sync::Arc;
 
+/// The longest light-group name, in bytes of UTF-8: OpenEXR channel
+/// names hold at most 255 bytes, and a group's channels are `NAME.R`.
+pub const MAX_LAYER_NAME_BYTES: usize = 253;
+
 /// Deep samples per pixel when none is given (the background sample
 /// comes on top).
 pub const DEFAULT_DEEP_SAMPLES: u32 = 16;
@@ -70,6 +74,15 @@ impl Compositing {
             if name.is_empty() || name.contains('.') || name.chars().any(char::is_whitespace) {
                 return Err(Error::invalid(format!(
                     "light group {name:?}: a layer name must be non-empty, without '.' or spaces"
+                )));
+            }
+            if name.len() > MAX_LAYER_NAME_BYTES || name.contains('\0') {
+                let shown: String = name.chars().take(40).collect();
+                return Err(Error::invalid(format!(
+                    "light group \"{shown}...\" is {} bytes in UTF-8: OpenEXR channel names \
+                     (the layer's `NAME.R`) hold at most 255, so at most {MAX_LAYER_NAME_BYTES} \
+                     for the name, and no NUL",
+                    name.len()
                 )));
             }
             if self.light_groups[..i].contains(name) {

@@ -25,7 +25,7 @@ use openusd::usd::Prim;
 use crate::description::{EnvironmentSpec, LightSpec, SunSpec};
 use crate::error::{Error, Result};
 
-use super::values::{attr_asset, attr_number, attr_text, attr_triple, value};
+use super::values::{attr_asset, attr_number, attr_text, attr_triple, shown_number, value};
 use super::xform::world_at;
 use super::Reader;
 
@@ -61,9 +61,25 @@ fn emission(r: &mut Reader, path: &str, intensity_fallback: f64) -> Result<Vec3>
     let scale = intensity * exposure.exp2();
     let e = DVec3::from_array(colour) * scale;
     if !e.is_finite() || e.min_element() < 0.0 {
-        return Err(r.error(path, format!("emission {e} must be finite and >= 0")));
+        return Err(r.error(
+            path,
+            format!("emission {} must be finite and >= 0", shown(e)),
+        ));
     }
     Ok(e.as_vec3())
+}
+
+/// A vector as a person writes it: `(1e300, 0, 0)`.
+fn shown(v: DVec3) -> String {
+    format!("({})", v.to_array().map(shown_number).join(", "))
+}
+
+/// `spec` checked as a scene file's `[[light]]` is, after its values were
+/// converted to f32 (a double of 1e300 is infinite there), the error
+/// naming the stage and the prim.
+fn checked(r: &Reader, path: &str, spec: LightSpec) -> Result<LightSpec> {
+    spec.check().map_err(|e| r.error(path, e))?;
+    Ok(spec)
 }
 
 /// The sun of the `DistantLight` at `path`.
@@ -86,12 +102,14 @@ pub fn distant(r: &mut Reader, path: &str) -> Result<SunSpec> {
     if !direction.is_finite() || direction.length() < 1e-12 {
         return Err(r.error(path, "the light's transform gives it no direction"));
     }
-    Ok(SunSpec {
+    let sun = SunSpec {
         sun: Some(true),
         sun_dir: Some(direction.as_vec3().to_array()),
         sun_irradiance: Some(irradiance.to_array()),
         sun_angle: Some(angle as f32),
-    })
+    };
+    sun.check().map_err(|e| r.error(path, e))?;
+    Ok(sun)
 }
 
 /// The sky of the `DomeLight` at `path`.
@@ -113,10 +131,12 @@ pub fn dome(r: &mut Reader, path: &str) -> Result<EnvironmentSpec> {
     let texture = attr_asset(&p, "inputs:texture:file", t)?;
     let format = attr_text(&p, "inputs:texture:format", t)?.unwrap_or_else(|| "automatic".into());
     let Some((authored, resolved)) = texture.filter(|(a, _)| !a.is_empty()) else {
-        return Ok(EnvironmentSpec {
+        let env = EnvironmentSpec {
             env_radiance: Some(radiance.to_array()),
             ..Default::default()
-        });
+        };
+        env.check().map_err(|e| r.error(path, e))?;
+        return Ok(env);
     };
     if format != "automatic" && format != "latlong" {
         return Err(r.error(
@@ -137,40 +157,50 @@ pub fn dome(r: &mut Reader, path: &str) -> Result<EnvironmentSpec> {
     }
     let map = super::package::extracted(&map)
         .map_err(|e| Error::file(format!("{}: {path}: {e}", r.file)))?;
-    Ok(EnvironmentSpec {
+    let env = EnvironmentSpec {
         env_map: Some(map),
         env_intensity: Some((radiance.x + radiance.y + radiance.z) / 3.0),
         env_rotation: Some(rotation),
         ..Default::default()
-    })
+    };
+    env.check().map_err(|e| r.error(path, e))?;
+    Ok(env)
 }
 
 /// A `[[light]]` named `name` of the distant light at `path` (its sun
 /// table's numbers).
 pub fn extra_distant(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
     let sun = distant(r, path)?;
-    Ok(LightSpec {
-        kind: "distant".into(),
-        name: Some(name.into()),
-        direction: sun.sun_dir,
-        color: sun.sun_irradiance,
-        angle: sun.sun_angle,
-        ..Default::default()
-    })
+    checked(
+        r,
+        path,
+        LightSpec {
+            kind: "distant".into(),
+            name: Some(name.into()),
+            direction: sun.sun_dir,
+            color: sun.sun_irradiance,
+            angle: sun.sun_angle,
+            ..Default::default()
+        },
+    )
 }
 
 /// A `[[light]]` named `name` of the dome light at `path`.
 pub fn extra_dome(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
     let env = dome(r, path)?;
-    Ok(LightSpec {
-        kind: "dome".into(),
-        name: Some(name.into()),
-        color: env.env_radiance,
-        intensity: env.env_intensity,
-        map: env.env_map,
-        rotation: env.env_rotation,
-        ..Default::default()
-    })
+    checked(
+        r,
+        path,
+        LightSpec {
+            kind: "dome".into(),
+            name: Some(name.into()),
+            color: env.env_radiance,
+            intensity: env.env_intensity,
+            map: env.env_map,
+            rotation: env.env_rotation,
+            ..Default::default()
+        },
+    )
 }
 
 /// The `[[light]]` named `name` of the `SphereLight` at `path`: a sphere,
@@ -192,7 +222,11 @@ pub fn sphere(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
     if !position.is_finite() || !radius.is_finite() || radius < 0.0 {
         return Err(r.error(
             path,
-            format!("position {position} and radius {radius} must be finite, the radius >= 0"),
+            format!(
+                "position {} and radius {} must be finite, the radius >= 0",
+                shown(position),
+                shown_number(radius)
+            ),
         ));
     }
     let mut spec = LightSpec {
@@ -237,7 +271,7 @@ pub fn sphere(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
     if attr_asset(&p, "inputs:shaping:ies:file", t)?.is_some() {
         r.warn(format!("{path}: an IES profile is not applied"));
     }
-    Ok(spec)
+    checked(r, path, spec)
 }
 
 /// The `[[light]]` named `name` of the `RectLight` or `DiskLight` at
@@ -272,21 +306,29 @@ pub fn area(r: &mut Reader, path: &str, name: &str, kind: &str) -> Result<LightS
     if !(finite && sized) {
         return Err(r.error(
             path,
-            format!("a {kind} light needs a finite transform and a positive size (here {w} x {h})"),
+            format!(
+                "a {kind} light needs a finite transform and a positive size (here {} x {})",
+                shown_number(w),
+                shown_number(h)
+            ),
         ));
     }
-    Ok(LightSpec {
-        kind: kind.into(),
-        name: Some(name.into()),
-        position: Some(centre.as_vec3().to_array()),
-        direction: Some(normal.as_vec3().to_array()),
-        up: Some(y.as_vec3().to_array()),
-        width: Some(w as f32),
-        height: Some(h as f32),
-        color: Some(strength.to_array()),
-        normalize: Some(normalize),
-        ..Default::default()
-    })
+    checked(
+        r,
+        path,
+        LightSpec {
+            kind: kind.into(),
+            name: Some(name.into()),
+            position: Some(centre.as_vec3().to_array()),
+            direction: Some(normal.as_vec3().to_array()),
+            up: Some(y.as_vec3().to_array()),
+            width: Some(w as f32),
+            height: Some(h as f32),
+            color: Some(strength.to_array()),
+            normalize: Some(normalize),
+            ..Default::default()
+        },
+    )
 }
 
 /// The `[[light]]` named `name` of the `CylinderLight` at `path`: its
@@ -313,18 +355,26 @@ pub fn cylinder(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
     if !(finite && length > 0.0 && radius > 0.0) {
         return Err(r.error(
             path,
-            format!("a cylinder light needs a finite transform and a positive size (here length {length}, radius {radius})"),
+            format!(
+                "a cylinder light needs a finite transform and a positive size (here length {}, radius {})",
+                shown_number(length),
+                shown_number(radius)
+            ),
         ));
     }
-    Ok(LightSpec {
-        kind: "cylinder".into(),
-        name: Some(name.into()),
-        position: Some(centre.as_vec3().to_array()),
-        direction: Some(x.as_vec3().to_array()),
-        length: Some(length as f32),
-        radius: Some(radius as f32),
-        color: Some(strength.to_array()),
-        normalize: Some(normalize),
-        ..Default::default()
-    })
+    checked(
+        r,
+        path,
+        LightSpec {
+            kind: "cylinder".into(),
+            name: Some(name.into()),
+            position: Some(centre.as_vec3().to_array()),
+            direction: Some(x.as_vec3().to_array()),
+            length: Some(length as f32),
+            radius: Some(radius as f32),
+            color: Some(strength.to_array()),
+            normalize: Some(normalize),
+            ..Default::default()
+        },
+    )
 }

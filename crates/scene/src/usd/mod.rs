@@ -152,9 +152,9 @@ fn read_guarded(text: &str, file: &str) -> Result<StageScene> {
         time,
         warnings: Vec::new(),
     };
-    let prims = traverse(&reader)?;
+    let prims = traverse(&reader).map_err(|e| in_stage(e, file))?;
     composition_errors(&reader)?;
-    let description = describe(&mut reader, &prims)?;
+    let description = describe(&mut reader, &prims).map_err(|e| in_stage(e, file))?;
     composition_errors(&reader)?;
     Ok(StageScene {
         description,
@@ -162,8 +162,30 @@ fn read_guarded(text: &str, file: &str) -> Result<StageScene> {
     })
 }
 
-/// Every prim of the default traversal (instance proxies included) with
-/// its type.
+/// `e` with its message naming the stage file first, where the message
+/// (from a value read off a prim) names only the prim.
+fn in_stage(e: Error, file: &str) -> Error {
+    let named = |message: String| match message.starts_with(file) {
+        true => message,
+        false => format!("{file}: {message}"),
+    };
+    match e {
+        Error::Input { message, source } => Error::Input {
+            message: named(message),
+            source,
+        },
+        Error::File { message, source } => Error::File {
+            message: named(message),
+            source,
+        },
+        other => other,
+    }
+}
+
+/// Every visible prim of the default traversal (instance proxies
+/// included) with its type: a prim whose `visibility`, or an ancestor's,
+/// is `invisible` at the stage's start is not rendered (UsdGeomImageable's
+/// rule, which UsdLux lights and UsdVol volumes follow).
 fn traverse(r: &Reader) -> Result<Vec<(String, String)>> {
     let mut paths = Vec::new();
     r.stage
@@ -171,11 +193,23 @@ fn traverse(r: &Reader) -> Result<Vec<(String, String)>> {
             paths.push(p.as_str().to_string())
         })
         .map_err(|e| Error::input(format!("{}: {e:#}", r.file)))?;
-    paths
-        .into_iter()
-        .map(|p| Ok((values::type_name(&r.stage, &p)?, p)))
-        .map(|x: Result<(String, String)>| x.map(|(t, p)| (p, t)))
-        .collect()
+    let mut hidden: Vec<String> = Vec::new();
+    let mut visible = Vec::new();
+    for p in paths {
+        // The traversal is depth-first, parents first: a hidden parent is
+        // met before its children.
+        if hidden.iter().any(|h| p.starts_with(&format!("{h}/"))) {
+            continue;
+        }
+        let prim = r.stage.prim(p.as_str());
+        let visibility = values::attr_text(&prim, "visibility", r.time.start)?;
+        if visibility.as_deref() == Some("invisible") {
+            hidden.push(p);
+            continue;
+        }
+        visible.push((p.clone(), values::type_name(&r.stage, &p)?));
+    }
+    Ok(visible)
 }
 
 /// Fails on the stage's composition errors, listing them.

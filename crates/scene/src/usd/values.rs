@@ -75,12 +75,55 @@ pub fn attr_text(prim: &Prim, name: &str, time: f64) -> Result<Option<String>> {
 }
 
 fn not_a(prim: &Prim, name: &str, what: &str, v: &Value) -> Error {
-    let shown = format!("{v:?}");
-    let shown: String = shown.chars().take(60).collect();
     Error::input(format!(
-        "{}.{name}: expected a {what}, got {shown}",
-        prim.path().as_str()
+        "{}.{name}: expected a {what}, got {}",
+        prim.path().as_str(),
+        shown(v)
     ))
+}
+
+/// A number as a person writes it: `-1e38`, `0.25`, `nan`, `inf`.
+pub fn shown_number(x: f64) -> String {
+    if x.is_nan() {
+        "nan".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf" } else { "-inf" }.into()
+    } else if (x as f32) as f64 == x {
+        // A float (as most light inputs are authored): its own shortest
+        // digits, `-1e38` rather than the double's `-9.999999680285692e37`.
+        short(x as f32)
+    } else {
+        short(x)
+    }
+}
+
+/// The shortest digits that round-trip (Rust's), in exponent form when
+/// far from 1.
+fn short<T: std::fmt::Display + std::fmt::LowerExp + Into<f64> + Copy>(x: T) -> String {
+    let v: f64 = x.into();
+    if v != 0.0 && (v.abs() >= 1e6 || v.abs() < 1e-4) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// A value as a person writes it in a message: a number, a vector
+/// `(1, 2, nan)`, a quoted token or string, else its type.
+fn shown(v: &Value) -> String {
+    if let Some(x) = number(v) {
+        return shown_number(x);
+    }
+    if let Some(c) = triple(v) {
+        return format!("({})", c.map(shown_number).join(", "));
+    }
+    if let Some(t) = text(v) {
+        let t: String = t.chars().take(60).collect();
+        return format!("{t:?}");
+    }
+    let debug = format!("{v:?}");
+    let kind: String = debug.chars().take_while(|c| c.is_alphanumeric()).collect();
+    format!("a value of type {kind}")
 }
 
 /// An asset attribute at `time`: `(authored, resolved)`; `resolved` is
