@@ -46,6 +46,7 @@ mod flags;
 pub mod frames;
 pub mod grids;
 pub mod info;
+mod light_checks;
 pub mod lights;
 mod moving;
 mod output;

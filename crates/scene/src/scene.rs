@@ -76,7 +76,7 @@ impl Scene {
             return Err(Error::input("no [[volume]] in the scene"));
         }
         description.rebase(dir);
-        crate::lights::check_maps(&description)?;
+        crate::light_checks::check_maps(&description)?;
         crate::compositing::instance_names(&description)?;
         description.hold_file_samples();
         Ok(Scene {
