@@ -106,3 +106,63 @@ impl PassFilm {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::film::PixelAccumulator;
+
+    /// Moments of a sequence, as a device keeps them (Welford).
+    fn moments(xs: &[[f32; 4]]) -> PixelMoments {
+        let mut m = PixelMoments::default();
+        for x in xs {
+            m.n += 1;
+            for k in 0..4 {
+                let delta = x[k] - m.mean[k];
+                m.mean[k] += delta / m.n as f32;
+                m.m2[k] += delta * (x[k] - m.mean[k]);
+            }
+        }
+        m
+    }
+
+    /// Two passes merged give the mean and variance of all their
+    /// samples, as adding them one by one does.
+    #[test]
+    fn merged_passes_are_their_samples() {
+        let xs: Vec<[f32; 4]> = (0..13)
+            .map(|i| {
+                let v = (i as f32 * 0.37).sin() * 3.0 + 1.0;
+                [v, v * v, -v, 0.5]
+            })
+            .collect();
+        let (a, b) = xs.split_at(5);
+        let mut merged = PixelAccumulator::default();
+        for m in [moments(a), moments(b)] {
+            merged.merge(m.n, m.mean, m.m2);
+        }
+        let whole = moments(&xs);
+        assert_eq!(merged.count(), 13);
+        for k in 0..4 {
+            assert!((merged.mean()[k] - whole.mean[k]).abs() < 1e-5);
+            let v = whole.m2[k] / 12.0;
+            assert!((merged.variance()[k] - v).abs() <= 1e-4 * v.abs().max(1.0));
+        }
+    }
+
+    /// A film fed one pass resolves to its moments, in the window's place.
+    #[test]
+    fn a_pass_resolves_to_its_moments() {
+        let camera = Camera::new(glam::Vec3::ZERO, glam::Vec3::Z, glam::Vec3::Y, 40.0, 5, 3);
+        let mut film = PassFilm::new(&camera, &RenderSettings::default());
+        let pass: Vec<PixelMoments> = (0..15)
+            .map(|i| moments(&[[i as f32, 0.0, 0.0, 1.0], [i as f32 + 2.0, 0.0, 0.0, 1.0]]))
+            .collect();
+        film.add(&pass, 2);
+        let r = film.finish(RenderStats::default());
+        assert_eq!((r.image.width, r.image.height, r.image.spp), (5, 3, 2));
+        assert_eq!(r.image.pixel(3, 2)[0], 14.0);
+        assert_eq!(r.image.samples[7], 2);
+        assert_eq!(r.image.variance[7][0], 2.0);
+    }
+}
