@@ -123,7 +123,7 @@ pub fn open(software: bool) -> Result<Gpu, GpuError> {
         .min_by_key(|a| rank(&a.get_info()));
     let Some(adapter) = adapter else {
         let why = match found {
-            0 => "Vulkan found no device".to_string(),
+            0 => "no Vulkan driver or device".to_string(),
             n => format!("{n} software adapter(s) only, which --device auto does not use"),
         };
         return Err(GpuError::NoAdapter(why));

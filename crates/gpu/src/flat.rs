@@ -96,9 +96,16 @@ impl FlatScene {
         camera: &Camera,
         lights: &[Light],
     ) -> Self {
-        let level = &volume.levels[MAJORANT_LEVEL.min(volume.levels.len().saturating_sub(1))];
-        let majorants: Vec<f32> = level.cells.chunks_exact(2).map(|c| c[1]).collect();
-        let cell_edge = (BRICK as u32 * volume.dims[0]) as f32 / level.dims[0].max(1) as f32;
+        // An empty volume has no pyramid: one cell of majorant 0 (its box
+        // is empty too, so no walk reaches it).
+        let (majorants, cell_dims, cell_edge) = match volume.levels.get(MAJORANT_LEVEL) {
+            Some(level) => (
+                level.cells.chunks_exact(2).map(|c| c[1]).collect(),
+                level.dims,
+                (BRICK as u32 * volume.dims[0]) as f32 / level.dims[0].max(1) as f32,
+            ),
+            None => (vec![0.0], [1, 1, 1], BRICK as f32),
+        };
         let g = match &medium.phase {
             Phase::Hg(h) => h.g(),
             _ => 0.0,
@@ -118,9 +125,9 @@ impl FlatScene {
             phase: [g, 0.0, 0.0, 0.0],
             map_dims: [volume.dims[0], volume.dims[1], volume.dims[2], precision],
             cell_dims: [
-                level.dims[0],
-                level.dims[1],
-                level.dims[2],
+                cell_dims[0],
+                cell_dims[1],
+                cell_dims[2],
                 lights.len() as u32,
             ],
             ..camera_params(camera)

@@ -54,6 +54,91 @@ pub struct PixelSlot {
 /// Bytes of a pixel's path under way (`PathState` in `common.wgsl`).
 const PATH_STATE_BYTES: u64 = 80;
 
+/// The device's buffers, one a binding of `common.wgsl`.
+struct Buffers {
+    params: wgpu::Buffer,
+    map: wgpu::Buffer,
+    atlas: wgpu::Buffer,
+    constants: wgpu::Buffer,
+    majorants: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    film: wgpu::Buffer,
+    paths: wgpu::Buffer,
+    pending: wgpu::Buffer,
+}
+
+/// Refuses a scene or window whose arrays exceed what a binding holds.
+fn check_sizes(gpu: &Gpu, scene: &FlatScene, pixels: u64) -> Result<(), GpuError> {
+    let largest = scene.largest_binding();
+    if largest > gpu.max_binding {
+        return Err(GpuError::Device(format!(
+            "the volume needs a {} MiB array and the device binds at most {} MiB \
+             (splitting the atlas is not done yet)",
+            largest >> 20,
+            gpu.max_binding >> 20
+        )));
+    }
+    // The paths under way are the larger per-pixel array.
+    let path_bytes = pixels * PATH_STATE_BYTES;
+    if path_bytes > gpu.max_binding {
+        return Err(GpuError::Device(format!(
+            "a {pixels}-pixel window needs {} MiB of paths and the device binds at most {} MiB",
+            path_bytes >> 20,
+            gpu.max_binding >> 20
+        )));
+    }
+    Ok(())
+}
+
+/// The scene uploaded, the film zeroed and the paths' room made.
+fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64) -> Buffers {
+    use wgpu::BufferUsages as U;
+    let init = |label: &str, bytes: &[u8], usage: U| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage,
+        })
+    };
+    let empty = |label: &str, size: u64, usage: U| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage,
+            mapped_at_creation: false,
+        })
+    };
+    let film = vec![PixelSlot::default(); pixels as usize];
+    Buffers {
+        params: init(
+            "params",
+            bytemuck::bytes_of(&scene.params),
+            U::UNIFORM | U::COPY_DST,
+        ),
+        map: init("brick map", bytemuck::cast_slice(&scene.map), U::STORAGE),
+        atlas: init("atlas", bytemuck::cast_slice(&scene.atlas), U::STORAGE),
+        constants: init(
+            "constants",
+            bytemuck::cast_slice(&scene.constants),
+            U::STORAGE,
+        ),
+        majorants: init(
+            "majorants",
+            bytemuck::cast_slice(&scene.majorants),
+            U::STORAGE,
+        ),
+        lights: init("lights", bytemuck::cast_slice(&scene.lights), U::STORAGE),
+        film: init(
+            "film",
+            bytemuck::cast_slice(&film),
+            U::STORAGE | U::COPY_SRC,
+        ),
+        // Zero-filled at creation: no path under way, no sample taken.
+        paths: empty("paths", pixels * PATH_STATE_BYTES, U::STORAGE),
+        pending: empty("pending", 4, U::STORAGE | U::COPY_SRC | U::COPY_DST),
+    }
+}
+
 /// The uploaded scene, the film on the device and the pipeline.
 pub struct Kernel<'g> {
     gpu: &'g Gpu,
@@ -70,63 +155,12 @@ impl<'g> Kernel<'g> {
     /// Uploads `scene` and builds the pipeline; refuses arrays larger than
     /// a binding may be.
     pub fn new(gpu: &'g Gpu, scene: &FlatScene) -> Result<Self, GpuError> {
-        let largest = scene.largest_binding();
-        if largest > gpu.max_binding {
-            return Err(GpuError::Device(format!(
-                "the volume needs a {} MiB array and the device binds at most {} MiB \
-                 (splitting the atlas is not done yet)",
-                largest >> 20,
-                gpu.max_binding >> 20
-            )));
-        }
-        let device = &gpu.device;
         let [w, h] = [scene.params.window[0], scene.params.window[1]];
         let pixels = u64::from(w) * u64::from(h);
-        let film_bytes = pixels * std::mem::size_of::<PixelSlot>() as u64;
-        if film_bytes > gpu.max_binding {
-            return Err(GpuError::Device(format!(
-                "a {w}x{h} window needs {} MiB of film and the device binds at most {} MiB",
-                film_bytes >> 20,
-                gpu.max_binding >> 20
-            )));
-        }
+        check_sizes(gpu, scene, pixels)?;
+        let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let storage = |label: &str, bytes: &[u8]| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytes,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
-        let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("params"),
-            contents: bytemuck::bytes_of(&scene.params),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
-        let map = storage("brick map", bytemuck::cast_slice(&scene.map));
-        let atlas = storage("atlas", bytemuck::cast_slice(&scene.atlas));
-        let constants = storage("constants", bytemuck::cast_slice(&scene.constants));
-        let majorants = storage("majorants", bytemuck::cast_slice(&scene.majorants));
-        let lights = storage("lights", bytemuck::cast_slice(&scene.lights));
-        let film = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("film"),
-            contents: bytemuck::cast_slice(&vec![PixelSlot::default(); pixels as usize]),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        });
-        let paths = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("paths"),
-            size: pixels * PATH_STATE_BYTES,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
-        let pending = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("pending"),
-            size: 4,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let b = upload(device, scene, pixels);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("path tracer"),
             source: wgpu::ShaderSource::Wgsl(Cow::Owned(source())),
@@ -139,18 +173,19 @@ impl<'g> Kernel<'g> {
             compilation_options: Default::default(),
             cache: None,
         });
-        let buffers = [
-            &params_buffer,
-            &map,
-            &atlas,
-            &constants,
-            &majorants,
-            &lights,
-            &film,
-            &paths,
-            &pending,
+        // In the order of `common.wgsl`'s bindings.
+        let bound = [
+            &b.params,
+            &b.map,
+            &b.atlas,
+            &b.constants,
+            &b.majorants,
+            &b.lights,
+            &b.film,
+            &b.paths,
+            &b.pending,
         ];
-        let entries: Vec<wgpu::BindGroupEntry> = buffers
+        let entries: Vec<wgpu::BindGroupEntry> = bound
             .iter()
             .enumerate()
             .map(|(i, b)| wgpu::BindGroupEntry {
@@ -169,9 +204,9 @@ impl<'g> Kernel<'g> {
         Ok(Self {
             gpu,
             params: scene.params,
-            params_buffer,
-            film,
-            pending,
+            params_buffer: b.params,
+            film: b.film,
+            pending: b.pending,
             pixels,
             pipeline,
             bind_group,

@@ -9,7 +9,10 @@
 //! - `support.rs`: what the kernel renders ([`unsupported`] names the
 //!   rest: other integrators and lights, other phase functions, chromatic
 //!   or emitting media, motion, several volumes, AOVs and compositing
-//!   layers, adaptive sampling, denoising).
+//!   layers, adaptive sampling, denoising), and where it reaches the same
+//!   expectation by other estimators than the settings name
+//!   ([`substitutions`]: ratio tracking, one level of majorants, random
+//!   numbers, every light at each vertex, no sunward scattering).
 //! - `flat.rs`: the prepared scene `cirrus-scene` makes for every render
 //!   (the [`PreparedScene`]) as flat arrays ([`FlatScene`]): the brick
 //!   map, the atlas as u32 words, the constant bricks, one level of the
@@ -42,7 +45,7 @@ use cirrus_render::{Budget, PassFilm, PixelMoments, RenderSettings, RenderStats,
 pub use device::{open, DeviceChoice, Gpu, GpuError, INSTALL_HINT};
 pub use flat::{FlatScene, LightRecord, Params, MAJORANT_LEVEL};
 pub use kernel::{source, PixelSlot, STAGES};
-pub use support::{unsupported, PreparedScene};
+pub use support::{substitutions, unsupported, PreparedScene};
 
 /// Renders `scene` with `settings` on `gpu`, or says why not: what the
 /// kernel does not render is refused by name before anything is uploaded.

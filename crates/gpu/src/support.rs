@@ -5,7 +5,10 @@
 use cirrus_bricks::Precision;
 use cirrus_kernel::medium::BrickField;
 use cirrus_kernel::transform_motion::MovingField;
-use cirrus_render::{IntegratorKind, Light, Phase, RenderSettings, Scene, Volumes};
+use cirrus_render::{
+    IntegratorKind, Light, LightSampling, MajorantMode, Phase, RenderSettings, SamplerKind, Scene,
+    Sunward, TransmittanceEstimator, Volumes,
+};
 
 /// The prepared scene the GPU backend takes: what `cirrus-scene` prepares
 /// for every render.
@@ -98,4 +101,42 @@ fn phase_refused(phase: &Phase) -> Option<&'static str> {
         Phase::Rayleigh(_) => Some("the Rayleigh phase function"),
         Phase::Table(_) => Some("tabulated phase functions"),
     }
+}
+
+/// Where the GPU estimates the same image by other means than `settings`
+/// name (each unbiased, so the expectation is the same; the noise is
+/// not), in words, for the caller to say; `None` where it uses those.
+pub fn substitutions(settings: &RenderSettings) -> Option<String> {
+    let mut out = Vec::new();
+    if settings.transmittance != TransmittanceEstimator::Ratio {
+        out.push(format!(
+            "ratio tracking for --transmittance {}",
+            settings.transmittance.name()
+        ));
+    }
+    if settings.majorant != MajorantMode::Hierarchy {
+        out.push(format!(
+            "one majorant level (4^3-voxel cells) for --majorant {}",
+            settings.majorant.name()
+        ));
+    }
+    if settings.sampler != SamplerKind::Random {
+        out.push(format!(
+            "random numbers for --sampler {}",
+            settings.sampler.name()
+        ));
+    }
+    if settings.light_sampling != LightSampling::All {
+        out.push(format!(
+            "every light at each vertex for --light-sampling {}",
+            settings.light_sampling.name()
+        ));
+    }
+    if settings.sunward != Sunward::Off {
+        out.push(format!(
+            "no sunward scattering for --sunward {}",
+            settings.sunward.name()
+        ));
+    }
+    (!out.is_empty()).then(|| out.join(", "))
 }

@@ -59,3 +59,24 @@ fn unsupported_features_are_named() {
     );
     assert!(message.contains("use --device cpu"), "{message}");
 }
+
+/// Estimators the GPU does not have are said, not refused: its own reach
+/// the same expectation.
+#[test]
+fn substituted_estimators_are_said() {
+    let mut settings = cirrus_render::RenderSettings::default();
+    let said = cirrus_gpu::substitutions(&settings).expect("the defaults differ");
+    for want in [
+        "--transmittance residual",
+        "--sampler sobol",
+        "--sunward auto",
+    ] {
+        assert!(said.contains(want), "{want:?} not in {said:?}");
+    }
+    settings.transmittance = cirrus_render::TransmittanceEstimator::Ratio;
+    settings.majorant = cirrus_render::MajorantMode::Hierarchy;
+    settings.sampler = cirrus_render::SamplerKind::Random;
+    settings.light_sampling = cirrus_render::LightSampling::All;
+    settings.sunward = cirrus_render::Sunward::Off;
+    assert_eq!(cirrus_gpu::substitutions(&settings), None);
+}

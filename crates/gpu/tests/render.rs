@@ -168,3 +168,28 @@ fn a_crop_is_the_same_pixels() {
         }
     }
 }
+
+/// A volume with no density renders the sky alone, exactly: every camera
+/// ray escapes with the sky's radiance.
+#[test]
+fn an_empty_volume_shows_the_sky() {
+    let Some(gpu) = gpu() else { return };
+    let s = scene(
+        r#"
+        [render]
+        spp = 2
+        [camera]
+        res = "6x4"
+        [sun]
+        enabled = false
+        [environment]
+        radiance = [0.25, 0.5, 1.0]
+        [[volume]]
+        file = "empty_grid.vdb"
+        "#,
+    );
+    let image = render_gpu(&gpu, &s).expect("GPU render").image;
+    for p in &image.rgba {
+        assert_eq!(*p, [0.25, 0.5, 1.0, 0.0]);
+    }
+}

@@ -57,6 +57,9 @@ impl Target {
         let prepared = scene.prepare(&mut cache, None)?;
         match cirrus_gpu::render(gpu, &prepared.scene, &prepared.settings) {
             Ok(mut rendered) => {
+                if let Some(means) = cirrus_gpu::substitutions(&prepared.settings) {
+                    eprintln!("cirrus: the GPU estimates the same image with {means}");
+                }
                 let s = &mut rendered.stats;
                 s.bytes_read = prepared.bytes_read;
                 s.grids_loaded = prepared.grids_loaded;
