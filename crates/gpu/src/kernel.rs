@@ -39,7 +39,8 @@ pub fn source() -> String {
 
 /// One pixel's running moments on the device (`PixelSlot` in
 /// `common.wgsl`): with the samples replaced by zero for not being
-/// finite, and those cut short by the device's loop limit.
+/// finite, those cut short by the device's loop limit, and the
+/// collisions its paths took.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct PixelSlot {
@@ -48,7 +49,10 @@ pub struct PixelSlot {
     pub n: u32,
     pub nonfinite: u32,
     pub cut: u32,
-    pub pad: u32,
+    pub reals: u32,
+    pub nulls: u32,
+    pub shadows: u32,
+    pub pad: [u32; 2],
 }
 
 /// Bytes of a pixel's path under way (`PathState` in `common.wgsl`).

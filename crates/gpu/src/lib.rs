@@ -105,6 +105,9 @@ pub fn render(
     stats.counters.nonfinite_samples = slots.iter().map(|p| u64::from(p.nonfinite)).sum();
     // Paths the device cut short end where they were, as capped ones do.
     stats.counters.collision_cap_hits = slots.iter().map(|p| u64::from(p.cut)).sum();
+    stats.counters.real_collisions = slots.iter().map(|p| u64::from(p.reals)).sum();
+    stats.counters.null_collisions = slots.iter().map(|p| u64::from(p.nulls)).sum();
+    stats.counters.shadow_collisions = slots.iter().map(|p| u64::from(p.shadows)).sum();
     Ok(film.finish(stats))
 }
 

@@ -84,8 +84,12 @@ fn gpu_agrees_with_cpu() {
         g = 0.6
         "#,
     );
-    let g = render_gpu(&gpu, &s).expect("GPU render").image;
+    let gr = render_gpu(&gpu, &s).expect("GPU render");
     let c = render_cpu(&s).image;
+    let counted = &gr.stats.counters;
+    assert!(counted.real_collisions > 0 && counted.shadow_collisions > 0);
+    assert_eq!(counted.paths, 16 * 16 * 64);
+    let g = gr.image;
     let mut worst: f64 = 0.0;
     for by in 0..4 {
         for bx in 0..4 {

@@ -38,7 +38,13 @@ struct PixelSlot {
     n: u32,
     nonfinite: u32,
     cut: u32,
-    pad: u32,
+    // Tentative collisions of free flights, real and null, and of shadow
+    // rays (crates/kernel/src/counters.rs).
+    reals: u32,
+    nulls: u32,
+    shadows: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 // A pixel's path under way, kept between dispatches (crates/kernel/src/
@@ -82,6 +88,11 @@ var<private> cut_short: bool;
 // way as many steps again before that limit.
 var<private> iterations: u32;
 const ITERATION_BUDGET: u32 = 32768u;
+
+// This invocation's collisions, added to its pixel's slot at its end.
+var<private> real_collisions: u32;
+var<private> null_collisions: u32;
+var<private> shadow_collisions: u32;
 
 const PI: f32 = 3.14159265358979;
 const FAR: f32 = 3.0e38;

@@ -24,8 +24,10 @@ fn free_flight(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> Fl
         }
         let xi = random(rng) * e.majorant;
         if xi < walk_sigma(&w, e.t) {
+            real_collisions += 1u;
             return Flight(FLIGHT_COLLISION, e.t);
         }
+        null_collisions += 1u;
     }
     cut_short = true;
     return Flight(FLIGHT_CAPPED, 0.0);

@@ -189,6 +189,9 @@ fn render_pass(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     st.rng = rng;
+    acc.reals += real_collisions;
+    acc.nulls += null_collisions;
+    acc.shadows += shadow_collisions;
     paths[slot] = st;
     film[slot] = acc;
     if st.sample < target_samples {

@@ -19,6 +19,7 @@ fn transmittance(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> 
         if e.kind == EVENT_CAPPED {
             return 0.0;
         }
+        shadow_collisions += 1u;
         tr *= max(1.0 - walk_sigma(&w, e.t) / e.majorant, 0.0);
         if tr <= 0.0 {
             return 0.0;
