@@ -100,3 +100,30 @@ fn unknown_devices_are_refused() {
     assert!(!ok);
     assert!(err.contains("cpu, auto, gpu"), "{err}");
 }
+
+/// `auto` takes a hardware GPU or the CPU, never lavapipe, and says which.
+#[test]
+fn auto_says_where_it_renders() {
+    let d = scratch("auto");
+    let (ok, _, err) = cirrus(&[
+        "render",
+        "data/cloud.vdb",
+        "--device",
+        "auto",
+        "--res",
+        "8x6",
+        "--spp",
+        "1",
+        "-o",
+        d.join("a.exr").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let gpu = err.contains("rendering on the GPU");
+    let cpu = err.contains("rendering on the CPU");
+    assert!(gpu != cpu, "{err}");
+    assert!(
+        !(gpu && err.contains("(Cpu, ")),
+        "auto took a software adapter: {err}"
+    );
+    assert!(d.join("a.exr").exists());
+}
