@@ -112,8 +112,8 @@ pub fn render(
 }
 
 /// Most scattering events a dispatch advances a pixel's paths by; the
-/// kernel stops earlier once its walks have taken `ITERATION_BUDGET`
-/// steps (`common.wgsl`), which keeps a dispatch short on a GPU and within
+/// kernel stops earlier once it has run `ITERATION_BUDGET` loop
+/// iterations (`common.wgsl`), which keeps a dispatch short on a GPU and within
 /// lavapipe's 65535 loop iterations an invocation (a path cut there is
 /// detected and counted).
 const EVENTS_PER_DISPATCH: u32 = 4096;

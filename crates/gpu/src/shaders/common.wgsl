@@ -83,9 +83,10 @@ struct PathState {
 // of loops in all, and a walk cut there is no estimate of anything.
 var<private> cut_short: bool;
 
-// Walk steps this invocation has taken: a dispatch stops starting
-// scattering events past ITERATION_BUDGET, which leaves the event under
-// way as many steps again before that limit.
+// Loop iterations this invocation has run (every loop counts one a turn,
+// as llvmpipe counts them): a dispatch stops starting scattering events
+// past ITERATION_BUDGET, which leaves the event under way as many
+// iterations again before that limit.
 var<private> iterations: u32;
 const ITERATION_BUDGET: u32 = 32768u;
 

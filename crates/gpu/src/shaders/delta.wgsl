@@ -15,6 +15,7 @@ struct Flight {
 fn free_flight(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> Flight {
     var w = walk_start(origin, dir, rng);
     loop {
+        iterations += 1u;
         let e = walk_next(&w, rng);
         if e.kind == EVENT_END {
             return Flight(FLIGHT_ESCAPED, 0.0);

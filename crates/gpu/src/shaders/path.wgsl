@@ -1,9 +1,11 @@
 // The megakernel: one invocation owns one pixel of the window, takes its
 // samples in order and adds each to the pixel's running moments (so no
 // two invocations touch one pixel, and no sum depends on scheduling). A
-// dispatch advances each pixel's path by a few scattering events
-// (`params.window.w`) and keeps it in `paths` for the next: a dispatch
-// stays short on a GPU, and within lavapipe's loop limit (common.wgsl).
+// dispatch advances each pixel's paths by up to `params.window.w`
+// scattering events, starting none once it has run ITERATION_BUDGET loop
+// iterations, and keeps the path under way in `paths` for the next: a
+// dispatch stays short on a GPU, and within lavapipe's loop limit
+// (common.wgsl).
 //
 // Mirrors crates/kernel/src/integrator/path.rs (`trace`, `escape`,
 // `collide`, `scatter_from`, `roulette`) and path_light.rs (`direct_light`,
@@ -32,6 +34,7 @@ fn camera_dir(px: f32, py: f32) -> vec3<f32> {
 fn escape_radiance(dir: vec3<f32>, pdf: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < params.cell_dims.w; i++) {
+        iterations += 1u;
         let e = escaped_light(i, dir);
         if e.w > 0.0 {
             let w = select(1.0, power_heuristic(pdf, e.w), pdf > 0.0);
@@ -46,6 +49,7 @@ fn escape_radiance(dir: vec3<f32>, pdf: f32) -> vec3<f32> {
 fn direct_light(p: vec3<f32>, dir_in: vec3<f32>, mis: bool, rng: ptr<function, u32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < params.cell_dims.w; i++) {
+        iterations += 1u;
         let u1 = random(rng);
         let u2 = random(rng);
         let s = sample_light(i, dir_in, mis, u1, u2);

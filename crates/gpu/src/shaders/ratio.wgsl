@@ -12,6 +12,7 @@ fn transmittance(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> 
     var w = walk_start(origin, dir, rng);
     var tr = 1.0;
     loop {
+        iterations += 1u;
         let e = walk_next(&w, rng);
         if e.kind == EVENT_END {
             return tr;
