@@ -117,10 +117,10 @@ mod tests {
         let mut m = PixelMoments::default();
         for x in xs {
             m.n += 1;
-            for k in 0..4 {
-                let delta = x[k] - m.mean[k];
+            for (k, &v) in x.iter().enumerate() {
+                let delta = v - m.mean[k];
                 m.mean[k] += delta / m.n as f32;
-                m.m2[k] += delta * (x[k] - m.mean[k]);
+                m.m2[k] += delta * (v - m.mean[k]);
             }
         }
         m
