@@ -119,6 +119,23 @@ impl BrickVolume {
         self.atlas.precision()
     }
 
+    /// The brick map: one [`BrickRef`] word per brick, x-major (what a
+    /// device copy of the volume uploads).
+    pub fn map_words(&self) -> &[u32] {
+        &self.map
+    }
+
+    /// The values of constant bricks, indexed by [`BrickRef::Constant`].
+    pub fn constants(&self) -> &[f32] {
+        &self.constants
+    }
+
+    /// The stored bricks' voxels, 512 a brick, indexed by
+    /// [`BrickRef::Stored`], x-major within a brick (`x << 6 | y << 3 | z`).
+    pub fn atlas(&self) -> &Atlas {
+        &self.atlas
+    }
+
     /// Bytes of each part: (map, constants + ranges, atlas, bounds per level).
     pub fn memory_bytes(&self) -> (usize, usize, usize, Vec<usize>) {
         (

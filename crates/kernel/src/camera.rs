@@ -67,6 +67,11 @@ impl Camera {
     }
 
     /// Whether the camera moves while the shutter is open.
+    /// The near clipping distance (0: none).
+    pub fn near(&self) -> f32 {
+        self.near
+    }
+
     pub fn moves(&self) -> bool {
         self.motion.is_some()
     }

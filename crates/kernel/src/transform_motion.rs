@@ -139,6 +139,11 @@ impl<F: DensityField> MovingField<F> {
         }
     }
 
+    /// Whether the field moves over the shutter.
+    pub fn moves(&self) -> bool {
+        self.motion.is_some()
+    }
+
     /// The field placed at the frame's instant.
     pub fn still_field(&self) -> &F {
         &self.still

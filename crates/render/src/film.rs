@@ -59,6 +59,22 @@ impl PixelAccumulator {
         }
     }
 
+    /// Merges `n` samples given as their mean and `M2` (Chan, Golub and
+    /// LeVeque's pairwise update).
+    pub(crate) fn merge(&mut self, n: u32, mean: [f32; 4], m2: [f32; 4]) {
+        if n == 0 {
+            return;
+        }
+        let total = self.n + n;
+        let (na, nb) = (self.n as f32, n as f32);
+        for k in 0..4 {
+            let delta = mean[k] - self.mean[k];
+            self.mean[k] += delta * nb / total as f32;
+            self.m2[k] += m2[k] + delta * delta * na * nb / total as f32;
+        }
+        self.n = total;
+    }
+
     /// Samples added so far.
     #[inline]
     pub(crate) fn count(&self) -> u32 {

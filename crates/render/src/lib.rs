@@ -17,6 +17,8 @@
 //! - [`compositing`]: light groups, holdouts, deep samples and Cryptomatte,
 //!   as compositors read them.
 //! - [`majorant_choice`] probes a scene to choose its majorants.
+//! - [`PassFilm`] takes whole passes rendered elsewhere (the GPU backend)
+//!   as per-pixel moments into the same film.
 //!
 //! The kernel is [`kernel`]; the types a render's caller builds a scene
 //! from are re-exported here.
@@ -29,6 +31,7 @@ mod exr_read;
 mod film;
 pub mod image_io;
 pub mod majorant_choice;
+mod pass_film;
 mod path_setup;
 mod pixel_sampler;
 mod render;
@@ -42,6 +45,7 @@ pub use compositing::{Compositing, DepthHoldout, Layers};
 pub use control::RenderControl;
 pub use exr_read::read_env_map;
 pub use film::{AovImage, Halves, Image};
+pub use pass_film::{PassFilm, PixelMoments};
 pub use render::{render, Denoised, Rendered, Window};
 pub use scene::{
     fitted_tile_size, Budget, Crop, RenderSettings, Scene, DEFAULT_SEED, DEFAULT_SPP,

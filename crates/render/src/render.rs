@@ -228,7 +228,7 @@ fn integrate<M: Media>(
 }
 
 /// The window to render: the settings' crop clamped to the image, or all.
-fn crop_of(settings: &RenderSettings, camera: &Camera) -> Crop {
+pub(crate) fn crop_of(settings: &RenderSettings, camera: &Camera) -> Crop {
     let (w, h) = (camera.width(), camera.height());
     match settings.crop {
         Some(c) => {

@@ -120,6 +120,12 @@ impl Scene {
         self.render_cached(&mut VolumeCache::default(), control)
     }
 
+    /// An error where every sample of `rendered` was dropped as NaN or
+    /// infinite, whichever device made it: its image would be black.
+    pub fn refuse_all_dropped(rendered: &Rendered) -> Result<()> {
+        refuse_all_dropped(&rendered.stats.counters)
+    }
+
     /// What to tell the user about a finished render: samples it dropped
     /// as NaN or infinite (each counted, none written), and an image
     /// with no light in it at all.

@@ -1,4 +1,5 @@
 pub mod convert;
+pub mod device;
 pub mod info;
 pub mod merge;
 pub mod preview;

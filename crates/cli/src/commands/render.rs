@@ -4,7 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
+use super::device::{parse_device, Target};
 use super::CliResult;
+use cirrus_gpu::DeviceChoice;
 use cirrus_render::Rendered;
 use cirrus_scene::frames::{has_pattern, substitute, FrameRange};
 use cirrus_scene::{OutputFlags, Overrides, Scene, SceneFlags};
@@ -20,6 +22,12 @@ pub struct RenderArgs {
     /// skipped, so an interrupted sequence resumes where it stopped).
     #[arg(long)]
     pub overwrite: bool,
+    /// Where to render: cpu; auto (a hardware GPU where there is one, else
+    /// the CPU); gpu (any Vulkan adapter, lavapipe included). The GPU
+    /// renders the path tracer over one volume lit by a sun and a constant
+    /// sky, and refuses by name whatever else a scene asks for.
+    #[arg(long, default_value = "cpu", value_name = "DEVICE", value_parser = parse_device)]
+    pub device: DeviceChoice,
     /// Removed (learned path guiding); kept to say so.
     #[arg(long, hide = true, value_name = "MODE")]
     pub guiding: Option<String>,
@@ -39,13 +47,15 @@ pub fn run(args: &RenderArgs) -> CliResult {
     let mut overrides = args.scene.overrides();
     args.output.write_into(&mut overrides);
     let file = &args.scene.file;
-    match frame_range(args, &overrides)? {
+    let range = frame_range(args, &overrides)?;
+    let target = Target::open(args.device)?;
+    match range {
         None => {
             let scene = load(file, &overrides, None)?;
-            render_one(&scene, true)?;
+            render_one(&scene, &target, true)?;
             Ok(())
         }
-        Some(range) => sequence(file, &overrides, range, args.overwrite),
+        Some(range) => sequence(file, &overrides, range, args.overwrite, &target),
     }
 }
 
@@ -93,7 +103,11 @@ fn load(file: &Path, overrides: &Overrides, frame: Option<i64>) -> cirrus_scene:
 }
 
 /// Renders and writes one scene; `bar`: draw the render's own progress bar.
-fn render_one(scene: &Scene, bar: bool) -> Result<PathBuf, Box<dyn std::error::Error>> {
+fn render_one(
+    scene: &Scene,
+    target: &Target,
+    bar: bool,
+) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let outputs = scene.outputs();
     let Some(exr) = outputs.exr.clone() else {
         return Err(
@@ -106,7 +120,7 @@ fn render_one(scene: &Scene, bar: bool) -> Result<PathBuf, Box<dyn std::error::E
     }
     let mut scene = scene.clone();
     scene.progress_bar = bar;
-    let rendered = scene.render()?;
+    let rendered = target.render(&scene)?;
     for warning in Scene::render_warnings(&rendered) {
         eprintln!("cirrus: warning: {warning}");
     }
@@ -125,7 +139,13 @@ fn render_one(scene: &Scene, bar: bool) -> Result<PathBuf, Box<dyn std::error::E
 /// `overwrite` (outputs are written whole or not at all, so an existing
 /// file is a finished frame); a frame that fails is reported by number and
 /// file and the others go on; the run fails if any frame did.
-fn sequence(file: &Path, overrides: &Overrides, range: FrameRange, overwrite: bool) -> CliResult {
+fn sequence(
+    file: &Path,
+    overrides: &Overrides,
+    range: FrameRange,
+    overwrite: bool,
+    target: &Target,
+) -> CliResult {
     let bar = ProgressBar::new(range.count());
     bar.set_style(
         ProgressStyle::with_template("[{elapsed_precise}] [{wide_bar}] {pos}/{len} frames {msg}")
@@ -140,7 +160,9 @@ fn sequence(file: &Path, overrides: &Overrides, range: FrameRange, overwrite: bo
                 let done = scene.outputs().exr.filter(|p| p.exists() && !overwrite);
                 match done {
                     Some(_) => Ok(false),
-                    None => bar.suspend(|| render_one(&scene, false)).map(|_| true),
+                    None => bar
+                        .suspend(|| render_one(&scene, target, false))
+                        .map(|_| true),
                 }
             });
         match result {

@@ -1,0 +1,235 @@
+//! The flat form of a prepared scene: plain arrays and one block of
+//! parameters, the layout the WGSL kernels read (`shaders/common.wgsl`
+//! declares the same structs). Built once per render on the host,
+//! uploaded once.
+//!
+//! - `map`: the brick map, one `tag:2 | index:30` word a brick, x-major
+//!   (`crates/bricks/src/layout.rs`).
+//! - `atlas`: stored bricks' voxels as u32 words: f32 bits one a word, or
+//!   two f16 a word (the lower half the even voxel), 512 voxels a brick.
+//! - `constants`: constant bricks' values.
+//! - `majorants`: the maxima of one level of the bounds pyramid
+//!   (`crates/bricks/src/bounds.rs`), density units, x-major.
+//! - `lights`: tagged records, one a light at infinity.
+//! - `Params`: the render-to-local transform, the camera's basis, the
+//!   medium (density scale, albedo, HG g), sizes, the window, the seed.
+
+use bytemuck::{Pod, Zeroable};
+use cirrus_bricks::{Atlas, BrickVolume, BRICK};
+use cirrus_render::{Camera, Light, Medium, Phase};
+use glam::Vec3;
+
+/// The level of the bounds pyramid the kernel's DDA walks: level 0, cells
+/// of 4^3 voxels, the tightest majorants the pyramid has.
+pub const MAJORANT_LEVEL: usize = 0;
+
+/// Light record tags (`shaders/lights.wgsl`).
+pub const LIGHT_SUN: u32 = 0;
+pub const LIGHT_SKY: u32 = 1;
+
+/// Means `max_depth` is unlimited.
+pub const UNLIMITED_DEPTH: u32 = u32::MAX;
+
+/// The kernel's parameters (a uniform block: vec4-sized fields only).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct Params {
+    /// Column-major render-to-local (index space) matrix.
+    pub local_from_render: [[f32; 4]; 4],
+    pub cam_origin: [f32; 4],
+    /// Camera ray direction before normalisation: `forward + sx right +
+    /// sy up` for `sx, sy` in [-1, 1] across the image.
+    pub cam_forward: [f32; 4],
+    pub cam_right: [f32; 4],
+    pub cam_up: [f32; 4],
+    /// Albedo (xyz) and density scale (w).
+    pub albedo: [f32; 4],
+    /// Local extent of the brick grid in voxels (xyz), majorant cell edge
+    /// in voxels (w).
+    pub extent: [f32; 4],
+    /// HG g (x).
+    pub phase: [f32; 4],
+    /// Bricks per axis (xyz), atlas precision (w: 0 f32, 1 f16).
+    pub map_dims: [u32; 4],
+    /// Majorant cells per axis (xyz), light count (w).
+    pub cell_dims: [u32; 4],
+    /// Full image width and height, window origin x0, y0.
+    pub image: [u32; 4],
+    /// Window width and height, first sample of the pass, samples in it.
+    pub window: [u32; 4],
+    /// Seed (low, high word), max depth ([`UNLIMITED_DEPTH`]: none).
+    pub seed: [u32; 4],
+}
+
+/// One light at infinity.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct LightRecord {
+    /// x: [`LIGHT_SUN`] or [`LIGHT_SKY`].
+    pub tag: [u32; 4],
+    /// Sun: direction from the light (xyz), `1 - cos` of its half angle (w).
+    pub dir: [f32; 4],
+    /// Sun: irradiance (xyz), solid angle (w, 0 for a delta sun).
+    /// Sky: radiance (xyz).
+    pub radiance: [f32; 4],
+}
+
+/// The scene as arrays, ready to upload.
+pub struct FlatScene {
+    pub params: Params,
+    pub map: Vec<u32>,
+    pub atlas: Vec<u32>,
+    pub constants: Vec<f32>,
+    pub majorants: Vec<f32>,
+    pub lights: Vec<LightRecord>,
+}
+
+impl FlatScene {
+    /// The flat form of one medium over `volume`, placed by
+    /// `local_ray` (render-space origin and direction to local ones), seen
+    /// by `camera` and lit by `lights` (lights at infinity only: the
+    /// caller has refused the rest).
+    pub fn new<F>(
+        medium: &Medium<F>,
+        volume: &BrickVolume,
+        local_ray: impl Fn(Vec3, Vec3) -> (Vec3, Vec3),
+        camera: &Camera,
+        lights: &[Light],
+    ) -> Self {
+        // An empty volume has no pyramid: one cell of majorant 0 (its box
+        // is empty too, so no walk reaches it).
+        let (majorants, cell_dims, cell_edge) = match volume.levels.get(MAJORANT_LEVEL) {
+            Some(level) => (
+                level.cells.chunks_exact(2).map(|c| c[1]).collect(),
+                level.dims,
+                (BRICK as u32 * volume.dims[0]) as f32 / level.dims[0].max(1) as f32,
+            ),
+            None => (vec![0.0], [1, 1, 1], BRICK as f32),
+        };
+        let g = match &medium.phase {
+            Phase::Hg(h) => h.g(),
+            _ => 0.0,
+        };
+        let (atlas, precision) = atlas_words(volume.atlas());
+        let lights: Vec<LightRecord> = lights.iter().filter_map(light_record).collect();
+        let extent = volume.local_extent();
+        let params = Params {
+            local_from_render: local_matrix(local_ray),
+            albedo: [
+                medium.albedo.x,
+                medium.albedo.y,
+                medium.albedo.z,
+                medium.density_scale,
+            ],
+            extent: [extent.x, extent.y, extent.z, cell_edge],
+            phase: [g, 0.0, 0.0, 0.0],
+            map_dims: [volume.dims[0], volume.dims[1], volume.dims[2], precision],
+            cell_dims: [
+                cell_dims[0],
+                cell_dims[1],
+                cell_dims[2],
+                lights.len() as u32,
+            ],
+            ..camera_params(camera)
+        };
+        Self {
+            params,
+            map: non_empty(volume.map_words().to_vec(), 0),
+            atlas: non_empty(atlas, 0),
+            constants: non_empty(volume.constants().to_vec(), 0.0),
+            majorants: non_empty(majorants, 0.0),
+            lights: non_empty(lights, LightRecord::default()),
+        }
+    }
+
+    /// Bytes of the largest array (what a storage binding must hold).
+    pub fn largest_binding(&self) -> u64 {
+        [
+            self.map.len() * 4,
+            self.atlas.len() * 4,
+            self.constants.len() * 4,
+            self.majorants.len() * 4,
+            self.lights.len() * std::mem::size_of::<LightRecord>(),
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(0) as u64
+    }
+}
+
+/// A storage binding may not be empty: one placeholder element.
+fn non_empty<T: Clone>(mut v: Vec<T>, fill: T) -> Vec<T> {
+    if v.is_empty() {
+        v.push(fill);
+    }
+    v
+}
+
+/// The atlas as u32 words, and its precision code.
+fn atlas_words(atlas: &Atlas) -> (Vec<u32>, u32) {
+    match atlas {
+        Atlas::F32(a) => (a.iter().map(|v| v.to_bits()).collect(), 0),
+        Atlas::F16(a) => (
+            a.chunks(2)
+                .map(|p| u32::from(p[0]) | u32::from(*p.get(1).unwrap_or(&0)) << 16)
+                .collect(),
+            1,
+        ),
+        // Refused before flattening (`support.rs`).
+        Atlas::U8(_) => (Vec::new(), 2),
+    }
+}
+
+/// The affine render-to-local map, read back from `local_ray` (which maps
+/// a render-space origin and direction): its columns are the images of
+/// the axes, its translation the image of the origin.
+fn local_matrix(local_ray: impl Fn(Vec3, Vec3) -> (Vec3, Vec3)) -> [[f32; 4]; 4] {
+    let (o, x) = local_ray(Vec3::ZERO, Vec3::X);
+    let (_, y) = local_ray(Vec3::ZERO, Vec3::Y);
+    let (_, z) = local_ray(Vec3::ZERO, Vec3::Z);
+    [
+        [x.x, x.y, x.z, 0.0],
+        [y.x, y.y, y.z, 0.0],
+        [z.x, z.y, z.z, 0.0],
+        [o.x, o.y, o.z, 1.0],
+    ]
+}
+
+/// The camera's origin and basis, read back from its own rays so that the
+/// kernel's rays are the CPU's (`crates/kernel/src/camera.rs`, `ray`): the
+/// ray through the middle of the right edge is `forward + right` and the
+/// one through the middle of the top edge `forward + up`, normalised.
+fn camera_params(camera: &Camera) -> Params {
+    let (w, h) = (camera.width() as f32, camera.height() as f32);
+    let forward = camera.forward();
+    let unscaled = |d: Vec3| d / d.dot(forward) - forward;
+    let centre = camera.ray(0.5 * w, 0.5 * h);
+    let right = unscaled(camera.ray(w, 0.5 * h).dir);
+    let up = unscaled(camera.ray(0.5 * w, 0.0).dir);
+    let v4 = |v: Vec3| [v.x, v.y, v.z, 0.0];
+    Params {
+        cam_origin: v4(centre.origin),
+        cam_forward: v4(forward),
+        cam_right: v4(right),
+        cam_up: v4(up),
+        ..Default::default()
+    }
+}
+
+/// A light at infinity as a record (`None` for the others, refused before).
+fn light_record(light: &Light) -> Option<LightRecord> {
+    let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
+    match light {
+        Light::Distant(sun) => Some(LightRecord {
+            tag: [LIGHT_SUN, 0, 0, 0],
+            dir: v4(sun.direction(), sun.one_minus_cos_half_angle()),
+            radiance: v4(sun.irradiance(), sun.solid_angle()),
+        }),
+        Light::Dome(env) => Some(LightRecord {
+            tag: [LIGHT_SKY, 0, 0, 0],
+            dir: [0.0; 4],
+            radiance: v4(env.radiance, 0.0),
+        }),
+        _ => None,
+    }
+}

@@ -1,0 +1,346 @@
+//! The megakernel on the device: the WGSL stages joined into one module,
+//! the flat scene uploaded once, each pixel's path and the film's moments
+//! kept on the device across dispatches and read back at the end.
+
+use std::borrow::Cow;
+
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+use crate::device::{block_on, Gpu, GpuError};
+use crate::flat::{FlatScene, Params};
+
+/// The kernel's stages, in the order they are joined (WGSL declarations
+/// may come in any order; this is the order to read them in).
+pub const STAGES: [(&str, &str); 7] = [
+    ("common.wgsl", include_str!("shaders/common.wgsl")),
+    ("lookup.wgsl", include_str!("shaders/lookup.wgsl")),
+    ("walk.wgsl", include_str!("shaders/walk.wgsl")),
+    ("delta.wgsl", include_str!("shaders/delta.wgsl")),
+    ("ratio.wgsl", include_str!("shaders/ratio.wgsl")),
+    ("lights.wgsl", include_str!("shaders/lights.wgsl")),
+    ("path.wgsl", include_str!("shaders/path.wgsl")),
+];
+
+/// The entry point of `path.wgsl`.
+pub const ENTRY: &str = "render_pass";
+
+/// Pixels a workgroup covers per axis (`@workgroup_size(8, 8, 1)`).
+const GROUP: u32 = 8;
+
+/// The WGSL module: every stage, joined.
+pub fn source() -> String {
+    STAGES
+        .iter()
+        .map(|(_, s)| *s)
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// One pixel's running moments on the device (`PixelSlot` in
+/// `common.wgsl`): with the samples replaced by zero for not being
+/// finite, those cut short by the device's loop limit, and the
+/// collisions its paths took.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct PixelSlot {
+    pub mean: [f32; 4],
+    pub m2: [f32; 4],
+    pub n: u32,
+    pub nonfinite: u32,
+    pub cut: u32,
+    pub reals: u32,
+    pub nulls: u32,
+    pub shadows: u32,
+    pub pad: [u32; 2],
+}
+
+/// Bytes of a pixel's path under way (`PathState` in `common.wgsl`).
+const PATH_STATE_BYTES: u64 = 80;
+
+/// The device's buffers, one a binding of `common.wgsl`.
+struct Buffers {
+    params: wgpu::Buffer,
+    map: wgpu::Buffer,
+    atlas: wgpu::Buffer,
+    constants: wgpu::Buffer,
+    majorants: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    film: wgpu::Buffer,
+    paths: wgpu::Buffer,
+    pending: wgpu::Buffer,
+}
+
+/// Refuses a scene or window whose arrays exceed what a binding holds.
+fn check_sizes(gpu: &Gpu, scene: &FlatScene, pixels: u64) -> Result<(), GpuError> {
+    let largest = scene.largest_binding();
+    if largest > gpu.max_binding {
+        return Err(GpuError::Device(format!(
+            "the volume needs a {} MiB array and the device binds at most {} MiB \
+             (splitting the atlas is not done yet)",
+            largest >> 20,
+            gpu.max_binding >> 20
+        )));
+    }
+    // The paths under way are the larger per-pixel array.
+    let path_bytes = pixels * PATH_STATE_BYTES;
+    if path_bytes > gpu.max_binding {
+        return Err(GpuError::Device(format!(
+            "a {pixels}-pixel window needs {} MiB of paths and the device binds at most {} MiB",
+            path_bytes >> 20,
+            gpu.max_binding >> 20
+        )));
+    }
+    Ok(())
+}
+
+/// The scene uploaded, the film zeroed and the paths' room made.
+fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64) -> Buffers {
+    use wgpu::BufferUsages as U;
+    let init = |label: &str, bytes: &[u8], usage: U| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage,
+        })
+    };
+    let empty = |label: &str, size: u64, usage: U| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage,
+            mapped_at_creation: false,
+        })
+    };
+    let film = vec![PixelSlot::default(); pixels as usize];
+    Buffers {
+        params: init(
+            "params",
+            bytemuck::bytes_of(&scene.params),
+            U::UNIFORM | U::COPY_DST,
+        ),
+        map: init("brick map", bytemuck::cast_slice(&scene.map), U::STORAGE),
+        atlas: init("atlas", bytemuck::cast_slice(&scene.atlas), U::STORAGE),
+        constants: init(
+            "constants",
+            bytemuck::cast_slice(&scene.constants),
+            U::STORAGE,
+        ),
+        majorants: init(
+            "majorants",
+            bytemuck::cast_slice(&scene.majorants),
+            U::STORAGE,
+        ),
+        lights: init("lights", bytemuck::cast_slice(&scene.lights), U::STORAGE),
+        film: init(
+            "film",
+            bytemuck::cast_slice(&film),
+            U::STORAGE | U::COPY_SRC,
+        ),
+        // Zero-filled at creation: no path under way, no sample taken.
+        paths: empty("paths", pixels * PATH_STATE_BYTES, U::STORAGE),
+        pending: empty("pending", 4, U::STORAGE | U::COPY_SRC | U::COPY_DST),
+    }
+}
+
+/// The uploaded scene, the film on the device and the pipeline.
+pub struct Kernel<'g> {
+    gpu: &'g Gpu,
+    params: Params,
+    params_buffer: wgpu::Buffer,
+    film: wgpu::Buffer,
+    pending: wgpu::Buffer,
+    pixels: u64,
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+}
+
+impl<'g> Kernel<'g> {
+    /// Uploads `scene` and builds the pipeline; refuses arrays larger than
+    /// a binding may be.
+    pub fn new(gpu: &'g Gpu, scene: &FlatScene) -> Result<Self, GpuError> {
+        let [w, h] = [scene.params.window[0], scene.params.window[1]];
+        let pixels = u64::from(w) * u64::from(h);
+        check_sizes(gpu, scene, pixels)?;
+        let device = &gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let b = upload(device, scene, pixels);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("path tracer"),
+            source: wgpu::ShaderSource::Wgsl(Cow::Owned(source())),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("path tracer"),
+            layout: None,
+            module: &module,
+            entry_point: Some(ENTRY),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        // In the order of `common.wgsl`'s bindings.
+        let bound = [
+            &b.params,
+            &b.map,
+            &b.atlas,
+            &b.constants,
+            &b.majorants,
+            &b.lights,
+            &b.film,
+            &b.paths,
+            &b.pending,
+        ];
+        let entries: Vec<wgpu::BindGroupEntry> = bound
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        if let Some(e) = block_on(scope.pop()) {
+            return Err(GpuError::Device(format!("the kernel was refused: {e}")));
+        }
+        Ok(Self {
+            gpu,
+            params: scene.params,
+            params_buffer: b.params,
+            film: b.film,
+            pending: b.pending,
+            pixels,
+            pipeline,
+            bind_group,
+        })
+    }
+
+    /// Queues a dispatch: each pixel with fewer than `target` samples
+    /// advances its path by up to `events` scattering events (starting
+    /// its next samples as paths end).
+    pub fn dispatch(&mut self, target: u32, events: u32) {
+        self.params.window[2] = target;
+        self.params.window[3] = events;
+        let gpu = self.gpu;
+        gpu.queue
+            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("pass"),
+            });
+        encoder.clear_buffer(&self.pending, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pass"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            let [w, h] = [self.params.window[0], self.params.window[1]];
+            pass.dispatch_workgroups(w.div_ceil(GROUP), h.div_ceil(GROUP), 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// Waits for the passes queued so far.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Device(format!("waiting for a pass: {e}")))
+    }
+
+    /// The film's moments, read back (after every dispatch queued).
+    pub fn read_film(&self) -> Result<Vec<PixelSlot>, GpuError> {
+        let bytes = self.pixels * std::mem::size_of::<PixelSlot>() as u64;
+        let raw = self.read(&self.film, bytes)?;
+        Ok(bytemuck::cast_slice::<u8, PixelSlot>(&raw).to_vec())
+    }
+
+    /// How many pixels had samples left after the last dispatch.
+    pub fn pending(&self) -> Result<u32, GpuError> {
+        let raw = self.read(&self.pending, 4)?;
+        Ok(u32::from_le_bytes([raw[0], raw[1], raw[2], raw[3]]))
+    }
+
+    /// The first `bytes` of `buffer`, read back after every dispatch
+    /// queued.
+    fn read(&self, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>, GpuError> {
+        let device = &self.gpu.device;
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("film readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback"),
+        });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        self.gpu.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        let (send, receive) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = send.send(r);
+        });
+        self.wait()?;
+        receive
+            .recv()
+            .map_err(|e| GpuError::Device(format!("reading the film back: {e}")))?
+            .map_err(|e| GpuError::Device(format!("reading the film back: {e}")))?;
+        let view = slice
+            .get_mapped_range()
+            .map_err(|e| GpuError::Device(format!("reading the film back: {e:?}")))?;
+        Ok(view.to_vec())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The joined stages parse and validate as WGSL (naga, as wgpu's
+    /// Vulkan backend will), with no device needed.
+    #[test]
+    fn the_kernel_is_valid_wgsl() {
+        use wgpu::naga;
+        let module = naga::front::wgsl::parse_str(&source())
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source())));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source())));
+        assert!(module.entry_points.iter().any(|e| e.name == ENTRY));
+    }
+
+    /// The host's sizes of the device's structs are `common.wgsl`'s.
+    #[test]
+    fn struct_sizes_match_the_kernel() {
+        use wgpu::naga;
+        let module = naga::front::wgsl::parse_str(&source()).unwrap();
+        let size = |name: &str| {
+            let (_, ty) = module
+                .types
+                .iter()
+                .find(|(_, t)| t.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("no struct {name}"));
+            u64::from(ty.inner.size(module.to_ctx()))
+        };
+        assert_eq!(size("PixelSlot"), std::mem::size_of::<PixelSlot>() as u64);
+        assert_eq!(size("PathState"), PATH_STATE_BYTES);
+        assert_eq!(
+            size("Params"),
+            std::mem::size_of::<crate::flat::Params>() as u64
+        );
+        assert_eq!(
+            size("LightRecord"),
+            std::mem::size_of::<crate::flat::LightRecord>() as u64
+        );
+    }
+}

@@ -1,0 +1,157 @@
+//! The path tracer on a GPU: `cirrus-kernel`'s unbiased volume path
+//! tracing (delta tracking, ratio-tracked shadow rays, next-event
+//! estimation with MIS, Henyey-Greenstein scattering, Russian roulette)
+//! as one WGSL compute kernel run through `wgpu` on Vulkan, for the scenes
+//! it can render exactly, and a refusal naming everything else.
+//!
+//! How the parts fit:
+//!
+//! - `support.rs`: what the kernel renders ([`unsupported`] names the
+//!   rest: other integrators and lights, other phase functions, chromatic
+//!   or emitting media, motion, several volumes, AOVs and compositing
+//!   layers, adaptive sampling, denoising), and where it reaches the same
+//!   expectation by other estimators than the settings name
+//!   ([`substitutions`]: ratio tracking, one level of majorants, random
+//!   numbers, every light at each vertex, no sunward scattering).
+//! - `flat.rs`: the prepared scene `cirrus-scene` makes for every render
+//!   (the [`PreparedScene`]) as flat arrays ([`FlatScene`]): the brick
+//!   map, the atlas as u32 words, the constant bricks, one level of the
+//!   majorant pyramid, lights as tagged records and one block of
+//!   parameters (transform, camera, medium, window, seed).
+//! - `device.rs`: the adapter ([`open`]; [`DeviceChoice`] for the command
+//!   line) and [`GpuError`].
+//! - `kernel.rs` and `shaders/`: the megakernel, one WGSL file a stage
+//!   (`lookup`, `walk`, `delta`, `ratio`, `lights`, `path`), each citing
+//!   the CPU code it mirrors; the scene uploaded once, one pass a sample
+//!   per pixel, each pixel's running moments kept on the device by the one
+//!   invocation that owns it.
+//! - [`render`] reads the moments back into the host's film
+//!   ([`cirrus_render::PassFilm`]), so the image resolves and writes
+//!   (EXR, PNG) exactly as a CPU render's does.
+//!
+//! Same seed and settings give the same image on the same device: each
+//! sample's numbers are keyed by (seed, pixel, sample), and no sum depends
+//! on the order invocations run in.
+
+mod device;
+mod flat;
+mod kernel;
+mod support;
+
+use std::time::Instant;
+
+use cirrus_render::{Budget, PassFilm, PixelMoments, RenderSettings, RenderStats, Rendered};
+
+pub use device::{open, DeviceChoice, Gpu, GpuError, INSTALL_HINT};
+pub use flat::{FlatScene, LightRecord, Params, MAJORANT_LEVEL};
+pub use kernel::{source, PixelSlot, STAGES};
+pub use support::{substitutions, unsupported, PreparedScene};
+
+/// Renders `scene` with `settings` on `gpu`, or says why not: what the
+/// kernel does not render is refused by name before anything is uploaded.
+pub fn render(
+    gpu: &Gpu,
+    scene: &PreparedScene,
+    settings: &RenderSettings,
+) -> Result<Rendered, GpuError> {
+    settings
+        .validate()
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+    let refused = unsupported(scene, settings);
+    if !refused.is_empty() {
+        return Err(GpuError::Unsupported(refused));
+    }
+    let mut film = PassFilm::new(&scene.camera, settings);
+    let start = Instant::now();
+    let flat = flatten(scene, settings, &film);
+    let mut kernel = kernel::Kernel::new(gpu, &flat)?;
+    let setup_seconds = start.elapsed().as_secs_f64();
+    let spp = match settings.budget {
+        Budget::Spp(n) => {
+            run_to(&mut kernel, n.max(1))?;
+            n.max(1)
+        }
+        Budget::Time(seconds) => {
+            // One more sample of every pixel at a time, until the time is
+            // spent (at least one).
+            let mut n = 0;
+            while n == 0 || start.elapsed().as_secs_f64() < seconds {
+                n += 1;
+                run_to(&mut kernel, n)?;
+            }
+            n
+        }
+    };
+    let slots = kernel.read_film()?;
+    let moments: Vec<PixelMoments> = slots
+        .iter()
+        .map(|p| PixelMoments {
+            n: p.n,
+            mean: p.mean,
+            m2: p.m2,
+        })
+        .collect();
+    film.add(&moments, spp);
+    let mut stats = RenderStats {
+        integrator: settings.integrator.name().into(),
+        transmittance: "ratio".into(),
+        majorant: format!("grid: level {MAJORANT_LEVEL} of the bounds pyramid"),
+        light_sampling: "all".into(),
+        sunward: "off".into(),
+        setup_seconds,
+        ..Default::default()
+    };
+    stats.counters.paths = slots.iter().map(|p| u64::from(p.n)).sum();
+    stats.counters.nonfinite_samples = slots.iter().map(|p| u64::from(p.nonfinite)).sum();
+    // Paths the device cut short end where they were, as capped ones do.
+    stats.counters.collision_cap_hits = slots.iter().map(|p| u64::from(p.cut)).sum();
+    stats.counters.real_collisions = slots.iter().map(|p| u64::from(p.reals)).sum();
+    stats.counters.null_collisions = slots.iter().map(|p| u64::from(p.nulls)).sum();
+    stats.counters.shadow_collisions = slots.iter().map(|p| u64::from(p.shadows)).sum();
+    Ok(film.finish(stats))
+}
+
+/// Most scattering events a dispatch advances a pixel's paths by; the
+/// kernel stops earlier once it has run `ITERATION_BUDGET` loop
+/// iterations (`common.wgsl`), which keeps a dispatch short on a GPU and within
+/// lavapipe's 65535 loop iterations an invocation (a path cut there is
+/// detected and counted).
+const EVENTS_PER_DISPATCH: u32 = 4096;
+
+/// Dispatches queued between checks of whether every pixel is done.
+const DISPATCHES_PER_CHECK: u32 = 8;
+
+/// Dispatches until every pixel has `target` samples.
+fn run_to(kernel: &mut kernel::Kernel, target: u32) -> Result<(), GpuError> {
+    loop {
+        for _ in 0..DISPATCHES_PER_CHECK {
+            kernel.dispatch(target, EVENTS_PER_DISPATCH);
+        }
+        if kernel.pending()? == 0 {
+            return Ok(());
+        }
+    }
+}
+
+/// The flat form of `scene` for `film`'s window and `settings`' seed and
+/// depth (the caller has checked it is supported).
+fn flatten(scene: &PreparedScene, settings: &RenderSettings, film: &PassFilm) -> FlatScene {
+    let medium = &scene.media.instances()[0];
+    let field = medium.field.still_field();
+    let lights = scene.lights.clone().pruned();
+    let lights: Vec<_> = lights.iter().cloned().collect();
+    let mut flat = FlatScene::new(
+        medium,
+        field.volume(),
+        |o, d| field.local_ray(o, d),
+        &scene.camera,
+        &lights,
+    );
+    let w = film.window();
+    let camera = &scene.camera;
+    flat.params.image = [camera.width(), camera.height(), w.x0, w.y0];
+    flat.params.window = [w.x1 - w.x0, w.y1 - w.y0, 0, 0];
+    let depth = settings.max_depth.unwrap_or(flat::UNLIMITED_DEPTH);
+    flat.params.seed = [settings.seed as u32, (settings.seed >> 32) as u32, depth, 0];
+    flat
+}

@@ -1,0 +1,121 @@
+// Lights at infinity and the Henyey-Greenstein phase function.
+//
+// Mirrors crates/kernel/src/light/distant.rs (a delta sun, or a cone of
+// uniform radiance irradiance / solid angle), crates/kernel/src/light/dome.rs
+// (a constant sky sampled uniformly), crates/kernel/src/phase/hg.rs and
+// crates/kernel/src/sampling.rs (uniform_sphere, uniform_cone, from_local,
+// power_heuristic).
+
+const LIGHT_SUN: u32 = 0u;
+const LIGHT_SKY: u32 = 1u;
+const UNIFORM_SPHERE_PDF: f32 = 0.0795774715459;
+
+// HG density for scattering-angle cosine `mu`, written without
+// cancellation at the peak (hg.rs, eval_cos).
+fn hg_eval(mu_in: f32) -> f32 {
+    let g = params.phase.x;
+    let mu = clamp(mu_in, -1.0, 1.0);
+    var denom: f32;
+    if g >= 0.0 {
+        denom = (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - mu);
+    } else {
+        denom = (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + mu);
+    }
+    return (1.0 - g) * (1.0 + g) / (4.0 * PI * denom * sqrt(denom));
+}
+
+// Inverts the HG CDF in `mu` (hg.rs, sample_cos).
+fn hg_sample_cos(u: f32) -> f32 {
+    let g = params.phase.x;
+    if g == 0.0 {
+        return 1.0 - 2.0 * u;
+    }
+    let s = (1.0 - g) * (1.0 + g) / (1.0 - g + 2.0 * g * u);
+    return clamp((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0);
+}
+
+// The direction (x, y, z) in a frame whose z axis is `axis` (Duff et al.
+// 2017, glam's any_orthonormal_pair).
+fn from_local(axis: vec3<f32>, x: f32, y: f32, z: f32) -> vec3<f32> {
+    let sign = select(-1.0, 1.0, axis.z >= 0.0);
+    let a = -1.0 / (sign + axis.z);
+    let b = axis.x * axis.y * a;
+    let s = vec3<f32>(1.0 + sign * axis.x * axis.x * a, sign * b, -sign * axis.x);
+    let t = vec3<f32>(b, sign + axis.y * axis.y * a, -axis.y);
+    return normalize(x * s + y * t + z * axis);
+}
+
+// A phase-sampled direction (xyz) and its density (w) (phase/mod.rs, sample).
+fn phase_sample(dir_in: vec3<f32>, u1: f32, u2: f32) -> vec4<f32> {
+    let mu = hg_sample_cos(u1);
+    let sin_t = sqrt(max(1.0 - mu * mu, 0.0));
+    let phi = 2.0 * PI * u2;
+    let dir = from_local(dir_in, sin_t * cos(phi), sin_t * sin(phi), mu);
+    return vec4<f32>(dir, hg_eval(mu));
+}
+
+fn uniform_sphere(u1: f32, u2: f32) -> vec3<f32> {
+    let z = 1.0 - 2.0 * u1;
+    let r = sqrt(max(1.0 - z * z, 0.0));
+    let phi = 2.0 * PI * u2;
+    return vec3<f32>(r * cos(phi), r * sin(phi), z);
+}
+
+fn uniform_cone(axis: vec3<f32>, one_minus_cos: f32, u1: f32, u2: f32) -> vec3<f32> {
+    let omc = u1 * one_minus_cos;
+    let sin_t = sqrt(max(omc * (2.0 - omc), 0.0));
+    let phi = 2.0 * PI * u2;
+    return from_local(axis, sin_t * cos(phi), sin_t * sin(phi), 1.0 - omc);
+}
+
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let a2 = a * a;
+    let b2 = b * b;
+    if a2 + b2 > 0.0 {
+        return a2 / (a2 + b2);
+    }
+    return 0.0;
+}
+
+// A direction toward a light with its radiance and solid-angle density
+// (pdf < 0: a delta light, `radiance` its irradiance).
+struct LightSample {
+    to_light: vec3<f32>,
+    radiance: vec3<f32>,
+    pdf: f32,
+}
+
+// Light `i`'s sample at a vertex reached along `dir_in`. A constant sky at
+// a vertex without MIS (the last one) is drawn from the phase function
+// (path_light.rs, sky_sample).
+fn sample_light(i: u32, dir_in: vec3<f32>, mis: bool, u1: f32, u2: f32) -> LightSample {
+    let l = lights[i];
+    if l.tag.x == LIGHT_SUN {
+        let solid_angle = l.radiance.w;
+        if solid_angle <= 0.0 {
+            return LightSample(-l.dir.xyz, l.radiance.xyz, -1.0);
+        }
+        let to_light = uniform_cone(-l.dir.xyz, l.dir.w, u1, u2);
+        return LightSample(to_light, l.radiance.xyz / solid_angle, 1.0 / solid_angle);
+    }
+    if mis {
+        return LightSample(uniform_sphere(u1, u2), l.radiance.xyz, UNIFORM_SPHERE_PDF);
+    }
+    let s = phase_sample(dir_in, u1, u2);
+    return LightSample(s.xyz, l.radiance.xyz, s.w);
+}
+
+// Radiance (xyz) and sampling density (w) of light `i` seen by a ray
+// escaping along `dir`; w = 0 where it sees none (a delta sun, or outside
+// the sun's disc).
+fn escaped_light(i: u32, dir: vec3<f32>) -> vec4<f32> {
+    let l = lights[i];
+    if l.tag.x == LIGHT_SUN {
+        let solid_angle = l.radiance.w;
+        if solid_angle <= 0.0 || 1.0 + dot(dir, l.dir.xyz) > l.dir.w {
+            return vec4<f32>(0.0);
+        }
+        return vec4<f32>(l.radiance.xyz / solid_angle, 1.0 / solid_angle);
+    }
+    return vec4<f32>(l.radiance.xyz, UNIFORM_SPHERE_PDF);
+}

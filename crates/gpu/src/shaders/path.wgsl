@@ -1,0 +1,204 @@
+// The megakernel: one invocation owns one pixel of the window, takes its
+// samples in order and adds each to the pixel's running moments (so no
+// two invocations touch one pixel, and no sum depends on scheduling). A
+// dispatch advances each pixel's paths by up to `params.window.w`
+// scattering events, starting none once it has run ITERATION_BUDGET loop
+// iterations, and keeps the path under way in `paths` for the next: a
+// dispatch stays short on a GPU, and within lavapipe's loop limit
+// (common.wgsl).
+//
+// Mirrors crates/kernel/src/integrator/path.rs (`trace`, `escape`,
+// `collide`, `scatter_from`, `roulette`) and path_light.rs (`direct_light`,
+// `light_term`) for one grey medium lit by lights at infinity: every
+// collision scatters with the albedo as weight, every light is sampled at
+// every vertex (shadow rays by ratio tracking), phase-sampled directions
+// that escape take the power heuristic against those samples, Russian
+// roulette after 3 events below a throughput of 0.1.
+
+const ROULETTE_MIN_DEPTH: u32 = 3u;
+const ROULETTE_THROUGHPUT: f32 = 0.1;
+
+fn max3(v: vec3<f32>) -> f32 {
+    return max(v.x, max(v.y, v.z));
+}
+
+// The camera ray through image point (px, py) (camera.rs, ray).
+fn camera_dir(px: f32, py: f32) -> vec3<f32> {
+    let sx = 2.0 * px / f32(params.image.x) - 1.0;
+    let sy = 1.0 - 2.0 * py / f32(params.image.y);
+    return normalize(params.cam_forward.xyz + sx * params.cam_right.xyz + sy * params.cam_up.xyz);
+}
+
+// What lights at infinity add along an escaping ray; `pdf`: the density
+// its direction was phase-sampled with, 0 for a camera ray (full weight).
+fn escape_radiance(dir: vec3<f32>, pdf: f32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < params.cell_dims.w; i++) {
+        iterations += 1u;
+        let e = escaped_light(i, dir);
+        if e.w > 0.0 {
+            let w = select(1.0, power_heuristic(pdf, e.w), pdf > 0.0);
+            sum += e.xyz * w;
+        }
+    }
+    return sum;
+}
+
+// Next-event estimation at `p`, reached along `dir_in`: one sample of
+// every light, weighed against phase sampling where `mis`.
+fn direct_light(p: vec3<f32>, dir_in: vec3<f32>, mis: bool, rng: ptr<function, u32>) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < params.cell_dims.w; i++) {
+        iterations += 1u;
+        let u1 = random(rng);
+        let u2 = random(rng);
+        let s = sample_light(i, dir_in, mis, u1, u2);
+        let f = hg_eval(dot(dir_in, s.to_light));
+        var weight = 0.0;
+        if s.pdf < 0.0 {
+            weight = f;
+        } else if s.pdf > 0.0 {
+            let w = select(1.0, power_heuristic(s.pdf, f), mis);
+            weight = f * w / s.pdf;
+        }
+        if weight > 0.0 {
+            sum += s.radiance * (weight * transmittance(p, s.to_light, rng));
+        }
+    }
+    return sum;
+}
+
+// The camera path of sample `sample` of image pixel (x, y), started.
+fn start_path(x: u32, y: u32, pixel: u32, sample: u32) -> PathState {
+    var st: PathState;
+    var rng = rng_key(pixel, sample);
+    let jx = random(&rng);
+    let jy = random(&rng);
+    st.origin = vec4<f32>(params.cam_origin.xyz, 0.0);
+    st.dir = vec4<f32>(camera_dir(f32(x) + jx, f32(y) + jy), 0.0);
+    st.beta = vec4<f32>(1.0);
+    st.radiance = vec4<f32>(0.0);
+    st.rng = rng;
+    st.depth = 0u;
+    st.sample = sample;
+    st.under_way = 1u;
+    return st;
+}
+
+// One free flight of the path and the events at its end: escape, or the
+// collision's scattering (albedo, next-event estimation, the phase-sampled
+// direction, roulette). Returns true when the path has ended.
+fn advance(st: ptr<function, PathState>, rng: ptr<function, u32>) -> bool {
+    let origin = (*st).origin.xyz;
+    let dir = (*st).dir.xyz;
+    let flight = free_flight(origin, dir, rng);
+    if (*st).depth == 0u && flight.kind != FLIGHT_ESCAPED {
+        // Alpha: the track-length estimate of 1 - T along the camera ray.
+        (*st).dir.w = 1.0;
+    }
+    if flight.kind == FLIGHT_ESCAPED {
+        let e = escape_radiance(dir, (*st).origin.w);
+        (*st).radiance += vec4<f32>((*st).beta.xyz * e, 0.0);
+        return true;
+    }
+    let max_depth = params.seed.z;
+    if flight.kind == FLIGHT_CAPPED || (*st).depth == max_depth {
+        return true;
+    }
+    let p = origin + dir * flight.t;
+    (*st).depth += 1u;
+    let beta = (*st).beta.xyz * params.albedo.xyz;
+    (*st).beta = vec4<f32>(beta, 0.0);
+    if max3(beta) <= 0.0 {
+        return true;
+    }
+    let last = (*st).depth == max_depth;
+    (*st).radiance += vec4<f32>(beta * direct_light(p, dir, !last, rng), 0.0);
+    if last {
+        return true;
+    }
+    let u1 = random(rng);
+    let u2 = random(rng);
+    let s = phase_sample(dir, u1, u2);
+    (*st).origin = vec4<f32>(p, s.w);
+    (*st).dir = vec4<f32>(s.xyz, (*st).dir.w);
+    if (*st).depth >= ROULETTE_MIN_DEPTH {
+        let m = max3(beta);
+        if m < ROULETTE_THROUGHPUT {
+            if random(rng) >= m {
+                return true;
+            }
+            (*st).beta = vec4<f32>(beta / m, 0.0);
+        }
+    }
+    return false;
+}
+
+// Adds a finished sample (radiance, alpha) to the pixel's moments; a
+// non-finite sample counts as zero and is counted (crates/render/src/
+// film.rs, Tile::add).
+fn accumulate(acc: ptr<function, PixelSlot>, sample: vec4<f32>) {
+    var v = sample;
+    if !(finite(v.x) && finite(v.y) && finite(v.z) && finite(v.w)) {
+        v = vec4<f32>(0.0);
+        (*acc).nonfinite += 1u;
+    }
+    (*acc).n += 1u;
+    let delta = v - (*acc).mean;
+    (*acc).mean += delta / f32((*acc).n);
+    (*acc).m2 += delta * (v - (*acc).mean);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn render_pass(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = params.window.xy;
+    if id.x >= size.x || id.y >= size.y {
+        return;
+    }
+    let x = params.image.z + id.x;
+    let y = params.image.w + id.y;
+    // Keyed by the pixel's index in the full image, as the CPU's samples
+    // are, so a crop renders the same pixels as the whole image.
+    let pixel = y * params.image.x + x;
+    let slot = id.y * size.x + id.x;
+    let target_samples = params.window.z;
+    var st = paths[slot];
+    if st.sample >= target_samples {
+        return;
+    }
+    var acc = film[slot];
+    if st.under_way == 0u {
+        st = start_path(x, y, pixel, st.sample);
+    }
+    var rng = st.rng;
+    for (var k = 0u; k < params.window.w && iterations < ITERATION_BUDGET; k++) {
+        iterations += 1u;
+        let ended = advance(&st, &rng);
+        if ended || cut_short {
+            // A path cut short ends where it was, as a capped flight
+            // ends a CPU path, and is counted.
+            if cut_short {
+                acc.cut += 1u;
+                cut_short = false;
+            }
+            accumulate(&acc, vec4<f32>(st.radiance.xyz, st.dir.w));
+            let next = st.sample + 1u;
+            if next >= target_samples {
+                st.sample = next;
+                st.under_way = 0u;
+                break;
+            }
+            st = start_path(x, y, pixel, next);
+            rng = st.rng;
+        }
+    }
+    st.rng = rng;
+    acc.reals += real_collisions;
+    acc.nulls += null_collisions;
+    acc.shadows += shadow_collisions;
+    paths[slot] = st;
+    film[slot] = acc;
+    if st.sample < target_samples {
+        atomicAdd(&pending[0], 1u);
+    }
+}

@@ -1,0 +1,142 @@
+//! What the GPU kernel renders, and the refusal of everything else by
+//! name: a scene the kernel cannot render exactly as the CPU would (in
+//! expectation) is never rendered differently in silence.
+
+use cirrus_bricks::Precision;
+use cirrus_kernel::medium::BrickField;
+use cirrus_kernel::transform_motion::MovingField;
+use cirrus_render::{
+    IntegratorKind, Light, LightSampling, MajorantMode, Phase, RenderSettings, SamplerKind, Scene,
+    Sunward, TransmittanceEstimator, Volumes,
+};
+
+/// The prepared scene the GPU backend takes: what `cirrus-scene` prepares
+/// for every render.
+pub type PreparedScene<'v> = Scene<Volumes<MovingField<BrickField<'v>>>>;
+
+/// What the scene or settings ask for that the GPU kernel does not do,
+/// each named; empty when it renders them.
+pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut no = |what: &str| out.push(what.to_string());
+    if settings.integrator != IntegratorKind::Path {
+        no(&format!("the {} integrator", settings.integrator.name()));
+    }
+    if settings.adaptive.is_some() {
+        no("adaptive sampling");
+    }
+    if settings.aovs {
+        no("AOVs");
+    }
+    if settings.halves {
+        no("denoising");
+    }
+    let c = &settings.compositing;
+    if !c.light_groups.is_empty() {
+        no("light groups");
+    }
+    if c.cryptomatte {
+        no("Cryptomatte");
+    }
+    if c.deep_samples.is_some() {
+        no("deep images");
+    }
+    if c.holdout_depth.is_some() {
+        no("depth holdouts");
+    }
+    if scene.camera.moves() {
+        no("camera motion blur");
+    }
+    if scene.camera.near() != 0.0 {
+        no("near clipping");
+    }
+    for light in scene.lights.clone().pruned().iter() {
+        match light {
+            Light::Distant(_) => {}
+            Light::Dome(env) if env.map.is_none() => {}
+            Light::Dome(_) => no("environment maps (a constant sky only)"),
+            Light::Sphere(_) => no("sphere, point and spot lights"),
+            Light::Area(_) => no("area lights"),
+        }
+    }
+    let instances = scene.media.instances();
+    if instances.len() != 1 {
+        no(&format!(
+            "several volumes ({} in this scene; one only)",
+            instances.len()
+        ));
+    }
+    for m in instances {
+        if m.field.moves() || m.field.still_field().moves() {
+            no("volume motion blur");
+        }
+        if m.extinction_tint != glam::Vec3::ONE {
+            no("chromatic media (a density scale per channel)");
+        }
+        if m.emission.is_some() {
+            no("emission");
+        }
+        if m.holdout {
+            no("holdout volumes");
+        }
+        if let Some(phase) = phase_refused(&m.phase) {
+            no(phase);
+        }
+        if m.field.still_field().volume().precision() == Precision::U8 {
+            no("u8 bricks (f32 or f16 only)");
+        }
+    }
+    out.sort();
+    out.dedup();
+    out
+}
+
+/// The phase functions other than Henyey-Greenstein, by name.
+fn phase_refused(phase: &Phase) -> Option<&'static str> {
+    match phase {
+        Phase::Hg(_) => None,
+        Phase::TwoHg(_) => Some("the two-lobe Henyey-Greenstein phase function"),
+        Phase::Draine(_) => Some("the Draine phase function"),
+        Phase::HgDraine(_) => Some("the approximate Mie phase function (HG + Draine)"),
+        Phase::Rayleigh(_) => Some("the Rayleigh phase function"),
+        Phase::Table(_) => Some("tabulated phase functions"),
+    }
+}
+
+/// Where the GPU estimates the same image by other means than `settings`
+/// name (each unbiased, so the expectation is the same; the noise is
+/// not), in words, for the caller to say; `None` where it uses those.
+pub fn substitutions(settings: &RenderSettings) -> Option<String> {
+    let mut out = Vec::new();
+    if settings.transmittance != TransmittanceEstimator::Ratio {
+        out.push(format!(
+            "ratio tracking for --transmittance {}",
+            settings.transmittance.name()
+        ));
+    }
+    if settings.majorant != MajorantMode::Hierarchy {
+        out.push(format!(
+            "one majorant level (4^3-voxel cells) for --majorant {}",
+            settings.majorant.name()
+        ));
+    }
+    if settings.sampler != SamplerKind::Random {
+        out.push(format!(
+            "random numbers for --sampler {}",
+            settings.sampler.name()
+        ));
+    }
+    if settings.light_sampling != LightSampling::All {
+        out.push(format!(
+            "every light at each vertex for --light-sampling {}",
+            settings.light_sampling.name()
+        ));
+    }
+    if settings.sunward != Sunward::Off {
+        out.push(format!(
+            "no sunward scattering for --sunward {}",
+            settings.sunward.name()
+        ));
+    }
+    (!out.is_empty()).then(|| out.join(", "))
+}
