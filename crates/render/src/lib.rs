@@ -31,6 +31,7 @@ pub mod image_io;
 pub mod majorant_choice;
 mod path_setup;
 mod pixel_sampler;
+mod progress;
 mod render;
 mod scene;
 mod stats;
@@ -47,7 +48,7 @@ pub use scene::{
     fitted_tile_size, Budget, Crop, RenderSettings, Scene, DEFAULT_SEED, DEFAULT_SPP,
     DEFAULT_STEP_VOXELS, DEFAULT_TILE_SIZE, MIN_TILE_SIZE, TILES_PER_THREAD,
 };
-pub use stats::RenderStats;
+pub use stats::{CameraReport, RenderStats};
 
 pub use cirrus_kernel::{
     AreaLight, AreaShape, Blackbody, Bounds3, BrickField, Camera, CameraMotion, CameraPose,

@@ -24,6 +24,13 @@ pub struct ConvertArgs {
 
 pub fn run(args: &ConvertArgs) -> CliResult {
     let precision = Precision::from_name(&args.precision).expect("clap checked the name");
+    if !cirrus_scene::has_extension(&args.output, "cbrk") {
+        return Err(format!(
+            "{}: convert writes bricks (.cbrk); name the output OUT.cbrk",
+            args.output.display()
+        )
+        .into());
+    }
     let file = VolumeFile::open(&args.input)?;
     let index = choose_grid(&file, args.grid.as_deref())?;
     // Streamed: a .vdb grid goes into bricks without the reader's tree.
