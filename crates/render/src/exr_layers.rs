@@ -31,9 +31,11 @@ pub enum Aov {
     Emission,
     Direct,
     Samples,
-    /// Not an AOV of [`AovImage`]: asks for the light-group layers.
+    // Not an AovImage layer: switches on the compositing layers.
+    /// One layer per light group (`sun`, `sky`, `emission`, named lights),
+    /// summing to the beauty.
     Lights,
-    /// Not an AOV of [`AovImage`]: asks for the Cryptomatte layers.
+    /// Cryptomatte ID mattes per volume and per file.
     Cryptomatte,
 }
 

@@ -237,3 +237,48 @@ fn the_render_crates_defaults_are_the_declared_ones() {
     };
     assert_eq!(bits(&a), bits(&b));
 }
+
+/// The keys `data/scene_example.toml` shows, set or commented out, by
+/// table: a line `key = ...` (after an optional `# `) under `[table]` or
+/// `[[table]]` (itself perhaps commented out).
+fn example_keys(text: &str) -> Vec<(String, String)> {
+    let mut table = String::new();
+    let mut keys = Vec::new();
+    for line in text.lines() {
+        let line = line.trim_start_matches('#').trim();
+        if line.starts_with('[') {
+            let name = line.trim_matches(|c| c == '[' || c == ']');
+            if name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                table = name.to_string();
+            }
+            continue;
+        }
+        let Some((key, _)) = line.split_once('=') else {
+            continue;
+        };
+        let key = key.trim();
+        if !key.is_empty() && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            keys.push((table.clone(), key.to_string()));
+        }
+    }
+    keys
+}
+
+#[test]
+fn the_example_scene_names_every_setting_and_renders_as_read() {
+    let path = repo().join("data/scene_example.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let shown = example_keys(&text);
+    let missing: Vec<String> = settings()
+        .iter()
+        .filter(|s| !shown.iter().any(|(t, k)| t == s.table && k == s.key))
+        .map(|s| format!("[{}] {}", s.table, s.key))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "data/scene_example.toml, the commented reference, lacks: {}",
+        missing.join(", ")
+    );
+    // And what it sets (uncommented) is a valid scene.
+    cirrus_scene::SceneDescription::read(&path).unwrap();
+}

@@ -45,7 +45,7 @@ pub fn run(args: &ConvertArgs) -> CliResult {
     let write_s = start.elapsed().as_secs_f64();
     let i = &volume.info;
     eprintln!(
-        "{}: grid {:?}, {} active voxels -> {} bricks stored, {} constant, {} empty ({} precision, max error {:e}); read and converted {:.3} s ({:.1} M active voxels/s), written {:.3} s, {} bytes",
+        "{}: grid {:?}, {} active voxels -> {} bricks stored, {} constant, {} empty ({} precision, max error {}); read and converted {:.3} s ({:.1} M active voxels/s), written {:.3} s, {} bytes",
         args.output.display(),
         i.grid_name,
         i.active_voxels,
@@ -53,7 +53,10 @@ pub fn run(args: &ConvertArgs) -> CliResult {
         i.bricks_constant,
         i.bricks_empty,
         precision.name(),
-        i.max_error,
+        match i.max_error {
+            0.0 => "0, exact".to_string(),
+            e => format!("{e:.3e}"),
+        },
         convert_s,
         i.active_voxels as f64 / convert_s.max(1e-9) / 1e6,
         write_s,
