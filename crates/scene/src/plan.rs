@@ -192,9 +192,9 @@ pub fn plan(
     })
 }
 
-/// What to say when a volume's velocity is not used: the shutter is open
-/// and no velocity grid was found (with the file's vector grids, any of
-/// which `--velocity` can name), or one is named and the shutter closed.
+/// What to say when the shutter is open and a volume's density cannot
+/// move: no velocity grid was found (the file's vector grids listed, any
+/// of which `--velocity` can name), or a `.cbrk` holds none.
 fn velocity_warning(
     v: &VolumeSpec,
     moving: bool,
@@ -204,14 +204,10 @@ fn velocity_warning(
 ) -> Result<Option<String>> {
     let path = v.file.display();
     if !moving {
-        return Ok(v.velocity.as_ref().map(|name| {
-            format!(
-                "{path}: velocity grid {name:?} unused: the shutter is closed, so nothing \
-                 moves; open it (--shutter -0.25,0.25) for motion blur"
-            )
-        }));
+        return Ok(None);
     }
-    if found.is_some() {
+    // A time-sampled transform moves the volume whole: no velocity needed.
+    if found.is_some() || v.transform.samples.is_some() {
         return Ok(None);
     }
     if cbrk {
@@ -229,8 +225,8 @@ fn velocity_warning(
         ),
     };
     Ok(Some(format!(
-        "{path}: the shutter is open but no velocity grid was found (looked for {}): no \
-         motion blur; {listed}",
+        "{path}: the shutter is open but no velocity grid was found (looked for {}): its \
+         density does not move (no motion blur from it); {listed}",
         crate::grids::VELOCITY_GRIDS.join(", ")
     )))
 }

@@ -43,11 +43,15 @@ pub fn run(args: &RenderArgs) -> CliResult {
     match frame_range(args, &overrides)? {
         None => {
             let scene = load(file, &overrides, None)?;
+            warn_unused_velocity(&scene, &overrides);
             render_one(&scene, true)?;
             Ok(())
         }
         Some(range) => {
             outputs_tell_frames_apart(file, &overrides, &range)?;
+            if let Ok(scene) = load(file, &overrides, None) {
+                warn_unused_velocity(&scene, &overrides);
+            }
             sequence(file, &overrides, range, args.overwrite)
         }
     }
@@ -83,6 +87,18 @@ fn frame_range(
     Ok(from_file
         .map(|s| FrameRange::parse(&s).map_err(|e| format!("{}: [render] {e}", file.display())))
         .transpose()?)
+}
+
+/// `--velocity NAME` moves nothing while the shutter is closed: said,
+/// since the flag was given to blur.
+fn warn_unused_velocity(scene: &Scene, overrides: &Overrides) {
+    let [open, close] = scene.description().render.shutter();
+    if let (Some(name), true) = (&overrides.velocity, open == close) {
+        eprintln!(
+            "cirrus: warning: --velocity {name}: unused while the shutter is closed; open it \
+             (--shutter -0.25,0.25) for motion blur"
+        );
+    }
 }
 
 /// Several frames need outputs with a frame pattern: without one each
