@@ -98,6 +98,32 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<bool> {
 /// what a full render's denoising makes of them, the inputs are dropped
 /// and the `noisy`, `denoised` and `blend.weight` layers added.
 fn denoise_merged(merged: &mut ExrChannels, groups: &[String]) -> Result<()> {
+    let mut rendered = take_inputs(merged, groups)?;
+    crate::denoise::denoise(&mut rendered)?;
+    let channels = &mut merged.channels;
+    let beauty: Vec<[f32; 3]> = rendered
+        .image
+        .rgba
+        .iter()
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    set_rgb(channels, "", &beauty);
+    if let Some(layers) = &rendered.layers {
+        for (name, values) in layers.group_names.iter().zip(&layers.groups) {
+            set_rgb(channels, name, values);
+        }
+    }
+    let d = rendered.denoised.expect("denoise leaves its layers");
+    set_rgb(channels, "noisy", &d.noisy);
+    set_rgb(channels, "denoised", &d.plain);
+    channels.push(("blend.weight".into(), d.noisy_weight));
+    Ok(())
+}
+
+/// The render the tiles' channels describe, as far as the denoiser reads
+/// it (the beauty, the albedo guide, the variance, the halves and the
+/// light groups), the `denoise_input.*` channels taken out of `merged`.
+fn take_inputs(merged: &mut ExrChannels, groups: &[String]) -> Result<Rendered> {
     let (width, height) = merged.full;
     let channels = &mut merged.channels;
     let rgba = {
@@ -129,7 +155,7 @@ fn denoise_merged(merged: &mut ExrChannels, groups: &[String]) -> Result<()> {
             ..Default::default()
         }),
     };
-    let mut rendered = Rendered {
+    Ok(Rendered {
         image: Image {
             width: width as u32,
             height: height as u32,
@@ -152,38 +178,23 @@ fn denoise_merged(merged: &mut ExrChannels, groups: &[String]) -> Result<()> {
         halves: Some(Halves { a, b, samples }),
         denoised: None,
         layers,
-    };
-    crate::denoise::denoise(&mut rendered)?;
-    let set = |channels: &mut Channels, layer: &str, values: &[[f32; 3]]| {
-        for (c, ch) in RGB.iter().enumerate() {
-            let name = match layer {
-                "" => ch.to_string(),
-                l => format!("{l}.{ch}"),
-            };
-            let v = values.iter().map(|p| p[c]).collect();
-            match channels.iter_mut().find(|(n, _)| *n == name) {
-                Some((_, old)) => *old = v,
-                None => channels.push((name, v)),
-            }
-        }
-    };
-    let beauty: Vec<[f32; 3]> = rendered
-        .image
-        .rgba
-        .iter()
-        .map(|p| [p[0], p[1], p[2]])
-        .collect();
-    set(channels, "", &beauty);
-    if let Some(layers) = &rendered.layers {
-        for (name, values) in layers.group_names.iter().zip(&layers.groups) {
-            set(channels, name, values);
+    })
+}
+
+/// Sets the R, G, B channels of `layer` ("" for the beauty), adding them
+/// where they are missing.
+fn set_rgb(channels: &mut Channels, layer: &str, values: &[[f32; 3]]) {
+    for (c, ch) in RGB.iter().enumerate() {
+        let name = match layer {
+            "" => ch.to_string(),
+            l => format!("{l}.{ch}"),
+        };
+        let v = values.iter().map(|p| p[c]).collect();
+        match channels.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, old)) => *old = v,
+            None => channels.push((name, v)),
         }
     }
-    let d = rendered.denoised.expect("denoise leaves its layers");
-    set(channels, "noisy", &d.noisy);
-    set(channels, "denoised", &d.plain);
-    channels.push(("blend.weight".into(), d.noisy_weight));
-    Ok(())
 }
 
 fn missing(name: &str) -> Error {
