@@ -48,8 +48,9 @@ pub fn run(args: &RenderArgs) -> CliResult {
             Ok(())
         }
         Some(range) => {
-            outputs_tell_frames_apart(file, &overrides, &range)?;
+            // A scene file that cannot be read is reported per frame.
             if let Ok(scene) = load(file, &overrides, None) {
+                outputs_tell_frames_apart(&scene, &range)?;
                 warn_unused_velocity(&scene, &overrides);
             }
             sequence(file, &overrides, range, args.overwrite)
@@ -104,14 +105,10 @@ fn warn_unused_velocity(scene: &Scene, overrides: &Overrides) {
 /// Several frames need outputs with a frame pattern: without one each
 /// frame would write the same file (and, the file existing, the next
 /// frames would be skipped as finished).
-fn outputs_tell_frames_apart(file: &Path, overrides: &Overrides, range: &FrameRange) -> CliResult {
+fn outputs_tell_frames_apart(scene: &Scene, range: &FrameRange) -> CliResult {
     if range.count() < 2 {
         return Ok(());
     }
-    // A scene file that cannot be read is reported per frame.
-    let Ok(scene) = load(file, overrides, None) else {
-        return Ok(());
-    };
     let outputs = scene.outputs();
     for path in outputs.files() {
         if !has_pattern(&path.to_string_lossy()) {
@@ -153,12 +150,17 @@ fn render_one(scene: &Scene, bar: bool) -> Result<PathBuf, Box<dyn std::error::E
     for warning in scene.warnings() {
         eprintln!("cirrus: warning: {warning}");
     }
-    if outputs.denoise_at_merge {
-        eprintln!(
+    match (outputs.denoise_at_merge, &outputs.exr) {
+        (false, _) => {}
+        (true, Some(exr)) => eprintln!(
             "cirrus: a crop is denoised over the whole image by `cirrus merge`: {} keeps the \
              noisy image and the denoiser's inputs",
-            first.display()
-        );
+            exr.display()
+        ),
+        (true, None) => eprintln!(
+            "cirrus: warning: a crop is denoised over the whole image by `cirrus merge`, from \
+             its EXR; this PNG-only crop stays noisy"
+        ),
     }
     let mut scene = scene.clone();
     scene.progress_bar = bar;
