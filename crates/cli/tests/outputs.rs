@@ -85,6 +85,13 @@ fn the_format_is_told_by_the_extension() {
     // Without any output the message names both forms.
     let (ok, _, err) = render(&[]);
     assert!(!ok && err.contains("-o OUT.png"), "{err}");
+    // merge writes OpenEXR under an .exr name only.
+    let (ok, _, err) = cirrus(&["merge", &at("m.png"), s(&exr)]);
+    assert!(
+        !ok && err.contains("m.png") && err.contains(".exr"),
+        "{err}"
+    );
+    assert!(!d.join("m.png").exists());
     // convert writes bricks under a .cbrk name only.
     let wrong = d.join("c.exr");
     let (ok, _, err) = cirrus(&["convert", "data/cloud.vdb", "-o", s(&wrong)]);

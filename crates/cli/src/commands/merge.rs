@@ -18,6 +18,13 @@ pub struct MergeArgs {
 /// image where the tiles were rendered with `--denoise`; the result is bit
 /// for bit the full render when the tiles were rendered with its seed.
 pub fn run(args: &MergeArgs) -> CliResult {
+    if !cirrus_scene::has_extension(&args.output, "exr") {
+        return Err(format!(
+            "{}: merge writes OpenEXR; name the output .exr",
+            args.output.display()
+        )
+        .into());
+    }
     let tiles: Vec<&std::path::Path> = args.tiles.iter().map(|p| p.as_path()).collect();
     if cirrus_deep_exr::is_deep_file(tiles[0])? {
         cirrus_deep_exr::merge(&args.output, &tiles)?;
