@@ -145,8 +145,15 @@ impl Scene {
         }
         // A crop is denoised where the whole image exists, at the merge
         // (denoise_tiles.rs): it keeps the denoiser's inputs instead.
-        if self.description.render.denoise.unwrap_or(false) && self.outputs().crop.is_none() {
-            crate::denoise::denoise(&mut rendered)?;
+        if self.description.render.denoise.unwrap_or(false) {
+            match self.outputs().crop {
+                None => crate::denoise::denoise(&mut rendered)?,
+                Some(_) => rendered.stats.warnings.push(
+                    "a crop is not denoised alone: its EXR keeps the denoiser's inputs and \
+                     `cirrus merge` denoises the whole image"
+                        .into(),
+                ),
+            }
         }
         Ok(rendered)
     }
