@@ -47,13 +47,16 @@ fn denoised_crops_merge_bit_for_bit_into_the_denoised_full_render() {
         .iter()
         .enumerate()
     {
-        let t = d.join(format!("t{i}.exr"));
-        let (ok, _, err) = cirrus(&[&common[..], &["--crop", crop, "-o", s(&t)]].concat());
+        let (t, json) = (d.join(format!("t{i}.exr")), d.join(format!("t{i}.json")));
+        let args = ["--crop", crop, "-o", s(&t), "--stats", s(&json)];
+        let (ok, _, err) = cirrus(&[&common[..], &args].concat());
         assert!(ok, "{err}");
         assert!(
             err.contains("cirrus merge"),
             "the tile says where it is denoised: {err}"
         );
+        let stats = std::fs::read_to_string(&json).unwrap();
+        assert!(stats.contains("a crop is not denoised alone"), "{stats}");
         tiles.push(t);
     }
     let tile = cirrus_render::exr_layers::read_channels(&tiles[0]).unwrap();
