@@ -26,11 +26,12 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Convert a float grid into sparse bricks (.cbrk).
     Convert(commands::convert::ConvertArgs),
-    /// Render a volume, or a scene file (.toml), to EXR (and PNG).
+    /// Render a volume, a scene file (.toml) or a USD stage to EXR and/or PNG.
     Render(Box<commands::render::RenderArgs>),
     /// Assemble crop tiles (`render --crop`) into one full-size EXR.
     Merge(commands::merge::MergeArgs),
-    /// Serve a live progressive render in the browser.
+    /// Serve a live progressive render of a volume, scene file or USD stage
+    /// in the browser.
     Preview(commands::preview::PreviewArgs),
     /// Benchmarks that print figures.
     #[command(subcommand)]

@@ -142,3 +142,56 @@ fn a_reader_that_closes_stdout_early_gets_a_quiet_exit_not_a_panic() {
     assert_eq!(out.status.code(), Some(141), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+#[test]
+fn info_speaks_plainly_and_a_missing_grid_lists_the_grids() {
+    let (ok, out, err) = cirrus(&["info", "data/special_values.vdb"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("  type            float\n"), "{out}");
+    assert!(out.contains("  class           not set"), "{out}");
+    assert!(
+        !out.contains("unknown\n") || out.contains("GRID_UNKNOWN"),
+        "{out}"
+    );
+    let (ok, out, _) = cirrus(&["info", "data/cloud.vdb"]);
+    assert!(ok && out.contains("  class           fog volume"), "{out}");
+
+    let cbrk = std::env::temp_dir().join(format!("cirrus-info-exact-{}.cbrk", std::process::id()));
+    let c = cbrk.to_str().unwrap();
+    let (ok, _, err) = cirrus(&["convert", "data/sphere_fog.vdb", "-o", c]);
+    assert!(ok, "{err}");
+    assert!(err.contains("max error 0, exact"), "{err}");
+    let (ok, out, err) = cirrus(&["info", c]);
+    assert!(ok, "{err}");
+    assert!(out.contains("max error        0 (exact)"), "{out}");
+    assert!(!out.contains("0e0"), "{out}");
+    std::fs::remove_file(&cbrk).unwrap();
+
+    for args in [
+        &[
+            "render",
+            "data/multi_grid.vdb",
+            "--grid",
+            "smoke",
+            "-o",
+            "never.exr",
+        ][..],
+        &[
+            "convert",
+            "data/multi_grid.vdb",
+            "--grid",
+            "smoke",
+            "-o",
+            "never.cbrk",
+        ],
+    ] {
+        let (ok, _, err) = cirrus(args);
+        assert!(!ok, "{args:?}");
+        assert!(
+            err.contains(
+                "multi_grid.vdb: no grid named \"smoke\" (grids: \"velocity\", \"density\""
+            ),
+            "{err}"
+        );
+    }
+}

@@ -11,7 +11,9 @@
 //! How the parts fit:
 //! - [`SearchPath`] (module `search`) lists where the library may be:
 //!   `$CIRRUS_OIDN` (a file or directory; when set it is the only place
-//!   tried), `$OIDN_DIR/lib`, the `pyoidn` package of `python3` on PATH, then
+//!   tried), `$OIDN_DIR/lib`, the `pyoidn` package of a `venv` beside the
+//!   binary (`target/venv`, where `tools/oidn.sh` installs it), that of
+//!   `python3` on PATH, then
 //!   the system loader's `libOpenImageDenoise.so.2`.
 //! - The private `ffi` module resolves the few C entry points used, with the
 //!   signatures of `OpenImageDenoise/oidn.h` 2.x, into function pointers.
@@ -70,7 +72,8 @@ pub enum DenoiseError {
 fn not_found_message(tried: &[(PathBuf, String)]) -> String {
     let mut s = format!(
         "Open Image Denoise 2.x (libOpenImageDenoise.so.2) could not be loaded. \
-         Install it with `{INSTALL_HINT}` (into the python3 on PATH), or set CIRRUS_OIDN \
+         Install it with `{INSTALL_HINT}` (into the python3 on PATH) or `bash tools/oidn.sh \
+         target/venv/bin/python` (beside target/release/cirrus), or set CIRRUS_OIDN \
          to the library file or the directory holding it."
     );
     if tried.is_empty() {

@@ -26,6 +26,11 @@ pub struct SearchPath {
     /// A Python interpreter whose `pyoidn` package (the PyPI wheel, which
     /// bundles the library) is searched; `from_env` uses `python3` on PATH.
     pub python: Option<OsString>,
+    /// The running program: a `venv` in its directory or one or two above
+    /// holding `pyoidn` is searched, which is where `tools/oidn.sh` (run
+    /// by `tools/render_default.sh`) installs it for `target/release/cirrus`
+    /// (`target/venv`), so the denoiser keeps working after that script.
+    pub executable: Option<PathBuf>,
     /// Finally ask the dynamic loader for [`SYSTEM_NAME`].
     pub system: bool,
 }
@@ -43,6 +48,7 @@ impl SearchPath {
             cirrus_oidn: var("CIRRUS_OIDN"),
             oidn_dir: var("OIDN_DIR"),
             python: Some(OsString::from("python3")),
+            executable: std::env::current_exe().ok(),
             system: true,
         }
     }
@@ -63,6 +69,13 @@ impl SearchPath {
         if let Some(prefix) = &self.oidn_dir {
             out.extend(file_in(&prefix.join("lib")));
         }
+        if let Some(exe) = &self.executable {
+            for pkg in venv_pyoidn_dirs(exe) {
+                for dir in pyoidn_lib_dirs(&pkg) {
+                    out.extend(file_in(&dir));
+                }
+            }
+        }
         if let Some(python) = &self.python {
             if let Some(pkg) = pyoidn_dir(python) {
                 for dir in pyoidn_lib_dirs(&pkg) {
@@ -77,6 +90,27 @@ impl SearchPath {
         out.retain(|p| seen.insert(p.clone()));
         out
     }
+}
+
+/// The `pyoidn` packages of the virtual environments named `venv` in the
+/// directories holding `exe`, up to three levels up
+/// (`VENV/lib/pythonX.Y/site-packages/pyoidn`).
+pub fn venv_pyoidn_dirs(exe: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for dir in exe.ancestors().skip(1).take(3) {
+        let Ok(entries) = std::fs::read_dir(dir.join("venv").join("lib")) else {
+            continue;
+        };
+        let mut pythons: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
+        pythons.sort();
+        for python in pythons {
+            let pkg = python.join("site-packages").join("pyoidn");
+            if pkg.is_dir() {
+                out.push(pkg);
+            }
+        }
+    }
+    out
 }
 
 /// The first of [`LIBRARY_NAMES`] that exists as a file in `dir`.
@@ -124,4 +158,30 @@ print(list(s.submodule_search_locations)[0] if s and s.submodule_search_location
     let line = String::from_utf8(out.stdout).ok()?;
     let line = line.trim();
     (!line.is_empty()).then(|| PathBuf::from(line))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_venv_beside_the_binary_is_searched() {
+        let root = std::env::temp_dir().join(format!("cirrus-venv-search-{}", std::process::id()));
+        let lib = root.join("venv/lib/python3.11/site-packages/pyoidn/oidn/lib");
+        std::fs::create_dir_all(&lib).unwrap();
+        std::fs::create_dir_all(root.join("release")).unwrap();
+        std::fs::write(lib.join(LIBRARY_NAMES[0]), b"").unwrap();
+        let search = SearchPath {
+            executable: Some(root.join("release/cirrus")),
+            ..SearchPath::default()
+        };
+        assert_eq!(search.candidates(), vec![lib.join(LIBRARY_NAMES[0])]);
+        // Not from a binary elsewhere.
+        let elsewhere = SearchPath {
+            executable: Some(PathBuf::from("/nonexistent/bin/cirrus")),
+            ..SearchPath::default()
+        };
+        assert!(elsewhere.candidates().is_empty());
+        std::fs::remove_dir_all(&root).unwrap();
+    }
 }

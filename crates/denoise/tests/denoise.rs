@@ -189,6 +189,7 @@ fn missing_library_error_names_pip_install() {
         )),
         oidn_dir: None,
         python: Some("python3".into()),
+        executable: None,
         system: true,
     };
     // An explicit CIRRUS_OIDN is the only place tried, whatever else exists.

@@ -76,18 +76,25 @@ impl Camera {
         self.motion.is_some()
     }
 
+    /// [`Camera::framing_with_fov`] at a 35-degree vertical field of view
+    /// (the renderer's own test scenes).
+    pub fn framing(bounds: Bounds3, width: u32, height: u32) -> Self {
+        Self::framing_with_fov(bounds, width, height, 35.0)
+    }
+
     /// Frames the box `bounds` from a three-quarter view above and to the
     /// side (azimuth 40 degrees, elevation 20 degrees, +Y up as in most VDB
-    /// clouds), at the smallest distance from which all eight corners fall
-    /// inside the frame, plus a 5% margin.
-    pub fn framing(bounds: Bounds3, width: u32, height: u32) -> Self {
-        const VFOV: f32 = 35.0;
+    /// clouds) through a vertical field of view of `vfov_degrees`, at the
+    /// smallest distance from which all eight corners fall inside the
+    /// frame, plus a 5% margin.
+    pub fn framing_with_fov(bounds: Bounds3, width: u32, height: u32, vfov_degrees: f32) -> Self {
+        let vfov = vfov_degrees;
         const MARGIN: f32 = 1.05;
         let centre = bounds.centre();
         let (az, el) = (40f32.to_radians(), 20f32.to_radians());
         let view = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
         let aspect = width.max(1) as f32 / height.max(1) as f32;
-        let tan_v = (0.5 * VFOV.to_radians()).tan() / MARGIN;
+        let tan_v = (0.5 * vfov.to_radians()).tan() / MARGIN;
         let tan_h = tan_v * aspect;
         // Camera at centre + D view looking along -view: a corner at offset
         // c has depth D - c.view and must satisfy |c.right| <= tan_h depth
@@ -105,7 +112,7 @@ impl Camera {
             centre + distance * view,
             centre,
             Vec3::Y,
-            VFOV,
+            vfov,
             width,
             height,
         )

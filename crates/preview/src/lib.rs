@@ -54,7 +54,8 @@ use source::Source;
 /// How to run a preview.
 #[derive(Clone, Debug)]
 pub struct Config {
-    /// A volume (`.vdb`, `.nvdb`, `.cbrk`) or a scene file (`.toml`).
+    /// A volume (`.vdb`, `.nvdb`, `.cbrk`), a scene file (`.toml`) or a USD
+    /// stage (`.usd`, `.usda`, `.usdc`, `.usdz`).
     pub input: PathBuf,
     /// Loopback by default: the page controls the renderer and writes files.
     pub bind: IpAddr,

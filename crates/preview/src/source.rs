@@ -69,7 +69,8 @@ impl Source {
                 view.g = Some(desc.volumes[0].g());
             }
         }
-        let volume = path.extension().is_none_or(|e| e != "toml");
+        let scene_file = path.extension().is_some_and(|e| e == "toml");
+        let volume = !scene_file && !cirrus_scene::usd::is_usd(path);
         Ok(Source {
             kind: if volume { "volume" } else { "scene" },
             renderer: SceneRenderer {

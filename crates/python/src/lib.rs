@@ -153,7 +153,9 @@ fn render<'py>(
     // What the scene's reader could not render rides with the stats.
     let mut stats: serde_json::Value = serde_json::from_str(&rendered.stats.to_json())
         .map_err(|e| PyValueError::new_err(format!("stats: {e}")))?;
-    stats["warnings"] = serde_json::json!(scene.warnings());
+    let mut warnings = scene.warnings().to_vec();
+    warnings.extend(rendered.stats.warnings.iter().cloned());
+    stats["warnings"] = serde_json::json!(warnings);
     let mut aovs = aovs;
     aovs.extend(group_layers(py, &rendered));
     Ok((rgba, image.width, image.height, stats.to_string(), aovs))

@@ -31,9 +31,11 @@ pub enum Aov {
     Emission,
     Direct,
     Samples,
-    /// Not an AOV of [`AovImage`]: asks for the light-group layers.
+    // Not an AovImage layer: switches on the compositing layers.
+    /// One layer per light group (`sun`, `sky`, `emission`, named lights),
+    /// summing to the beauty.
     Lights,
-    /// Not an AOV of [`AovImage`]: asks for the Cryptomatte layers.
+    /// Cryptomatte ID mattes per volume and per file.
     Cryptomatte,
 }
 
@@ -144,8 +146,8 @@ pub fn write_exr_with(
 }
 
 /// Writes named f32 channels of a `size` data window at `position` inside
-/// a `full` display window.
-fn write_channels(
+/// a `full` display window, with text `attributes` in the header.
+pub fn write_channels(
     path: &Path,
     full: (usize, usize),
     position: (i32, i32),
@@ -198,6 +200,21 @@ fn utf8_text(s: &str) -> exr::prelude::Text {
 /// display window and channel names, lie inside the image, not overlap,
 /// and cover it exactly; any violation is an error naming the file.
 pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
+    let merged = assemble_tiles(tiles)?;
+    write_channels(
+        out,
+        merged.full,
+        (0, 0),
+        merged.full,
+        merged.channels,
+        merged.attributes,
+    )
+    .map_err(|e| Error::io(out, e))
+}
+
+/// The channels of crop tiles copied into place over the whole image (the
+/// checks of [`merge_tiles`]), without writing them.
+pub fn assemble_tiles(tiles: &[&Path]) -> Result<ExrChannels> {
     let first = tiles
         .first()
         .ok_or_else(|| Error::invalid("no tiles to merge"))?;
@@ -266,13 +283,11 @@ pub fn merge_tiles(out: &Path, tiles: &[&Path]) -> Result<()> {
             i / fw
         )));
     }
-    write_channels(
-        out,
-        (fw, fh),
-        (0, 0),
-        (fw, fh),
-        names.into_iter().zip(data).collect(),
+    Ok(ExrChannels {
+        full: (fw, fh),
+        position: (0, 0),
+        size: (fw, fh),
+        channels: names.into_iter().zip(data).collect(),
         attributes,
-    )
-    .map_err(|e| Error::io(out, e))
+    })
 }

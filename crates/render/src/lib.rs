@@ -34,6 +34,7 @@ pub mod majorant_choice;
 mod pass_film;
 mod path_setup;
 mod pixel_sampler;
+mod progress;
 mod render;
 mod scene;
 mod stats;
@@ -51,7 +52,7 @@ pub use scene::{
     fitted_tile_size, Budget, Crop, RenderSettings, Scene, DEFAULT_SEED, DEFAULT_SPP,
     DEFAULT_STEP_VOXELS, DEFAULT_TILE_SIZE, MIN_TILE_SIZE, TILES_PER_THREAD,
 };
-pub use stats::RenderStats;
+pub use stats::{CameraReport, RenderStats};
 
 pub use cirrus_kernel::{
     AreaLight, AreaShape, Blackbody, Bounds3, BrickField, Camera, CameraMotion, CameraPose,

@@ -1,19 +1,16 @@
 //! The render loop: tiles over rayon, sample passes, time budget, progress.
 
-use std::io::IsTerminal;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::adaptive::{Adaptive, Selection};
 use crate::compositing::Layers;
-use crate::control::RenderControl;
 use crate::film::{AovImage, Film, Halves, Image, Tile};
 use crate::majorant_choice;
 use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGrid};
 use crate::pixel_sampler::PixelSampler;
+use crate::progress::Progress;
 use crate::scene::{fitted_tile_size, Budget, Crop, RenderSettings, Scene};
 use crate::stats::RenderStats;
 use cirrus_kernel::integrator::{
@@ -122,6 +119,7 @@ fn render_with<M: Media>(
         &mut counters,
     );
     let wall_seconds = start.elapsed().as_secs_f64();
+    let samples = &out.image.samples;
     let stats = RenderStats {
         integrator: settings.integrator.name().into(),
         transmittance: settings.transmittance.name().into(),
@@ -138,6 +136,9 @@ fn render_with<M: Media>(
             IntegratorKind::Path => settings.sunward.name().into(),
             _ => String::new(),
         },
+        spp_mean: samples.iter().map(|&n| f64::from(n)).sum::<f64>() / samples.len().max(1) as f64,
+        spp_min: samples.iter().copied().min().unwrap_or(0),
+        spp_max: samples.iter().copied().max().unwrap_or(0),
         ..Default::default()
     };
     let crop = crop_of(settings, camera);
@@ -491,85 +492,5 @@ impl<S: CameraSampler> Passes<'_, S> {
             }
         }
         u64::from(s1 - s0)
-    }
-}
-
-/// A progress bar with ETA on stderr, or nothing when stderr is not a
-/// terminal or progress is off. Updated once per tile, never per sample.
-struct Progress {
-    bar: Option<ProgressBar>,
-    control: Option<Arc<RenderControl>>,
-    /// With a time budget the bar measures milliseconds, not samples.
-    timed: Option<(Instant, u64)>,
-}
-
-impl Progress {
-    fn new(settings: &RenderSettings, width: u32, height: u32) -> Self {
-        let (len, timed) = match settings.budget {
-            Budget::Spp(n) => {
-                let samples = u64::from(width) * u64::from(height) * u64::from(n.max(1));
-                (samples, None)
-            }
-            Budget::Time(s) => {
-                let ms = (s * 1000.0).max(1.0) as u64;
-                (ms, Some((Instant::now(), ms)))
-            }
-        };
-        let control = settings.control.clone();
-        if let Some(c) = &control {
-            c.start(len);
-        }
-        if !settings.progress || !std::io::stderr().is_terminal() {
-            return Self {
-                bar: None,
-                control,
-                timed,
-            };
-        }
-        let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-        let style = ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] [{wide_bar}] {percent:>3}% ETA {eta} {msg}",
-        )
-        .expect("valid template");
-        bar.set_style(style);
-        Self {
-            bar: Some(bar),
-            control,
-            timed,
-        }
-    }
-
-    fn cancelled(&self) -> bool {
-        self.control.as_ref().is_some_and(|c| c.is_cancelled())
-    }
-
-    fn tile_done(&self, samples: u64) {
-        let elapsed_ms = |(t0, ms): (Instant, u64)| (t0.elapsed().as_millis() as u64).min(ms);
-        if let Some(c) = &self.control {
-            match self.timed {
-                None => c.add(samples),
-                Some(t) => c.set(elapsed_ms(t)),
-            }
-        }
-        let Some(bar) = &self.bar else { return };
-        match self.timed {
-            None => bar.inc(samples),
-            Some(t) => bar.set_position(elapsed_ms(t)),
-        }
-    }
-
-    fn set_spp(&self, spp: u32) {
-        if let Some(bar) = &self.bar {
-            bar.set_message(format!("{spp} spp"));
-        }
-    }
-
-    fn finish(&self) {
-        if let (Some(c), Some((_, ms))) = (&self.control, self.timed) {
-            c.set(ms);
-        }
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
     }
 }

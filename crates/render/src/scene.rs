@@ -108,7 +108,8 @@ pub struct RenderSettings {
     /// smaller) so its last tiles do not leave threads idle. Images do not
     /// depend on it.
     pub tile_size: u32,
-    /// Show a progress bar (only ever drawn when stderr is a terminal).
+    /// Show progress on stderr: a bar on a terminal, else a plain line
+    /// every few seconds (`progress.rs`).
     pub progress: bool,
     /// Render only this window of the camera's image (render farms); its
     /// pixels are bit-identical to the same pixels of a full render.

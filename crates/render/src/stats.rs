@@ -49,6 +49,29 @@ pub struct RenderStats {
     pub denoise_seconds: f64,
     /// Camera paths per second of wall time.
     pub rays_per_second: f64,
+    /// Samples per pixel over the image: their mean, fewest and most
+    /// (with adaptive sampling they differ from pixel to pixel).
+    pub spp_mean: f64,
+    pub spp_min: u32,
+    pub spp_max: u32,
+    /// The camera as rendered, in world space (set by the caller that
+    /// placed it; `None` when unknown).
+    pub camera: Option<CameraReport>,
+    /// What loading found wrong but could render (bad voxels, an open
+    /// shutter with no velocity grid).
+    pub warnings: Vec<String>,
+}
+
+/// Where the camera was, in world space, and whether it was framed on the
+/// volumes because none was given.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CameraReport {
+    pub from: [f64; 3],
+    pub to: [f64; 3],
+    pub up: [f32; 3],
+    /// Vertical field of view in degrees.
+    pub fov: f32,
+    pub framed: bool,
 }
 
 impl RenderStats {

@@ -19,7 +19,7 @@ pub const OBJECT_LAYER: &str = "CryptoObject";
 pub const ASSET_LAYER: &str = "CryptoAsset";
 
 /// Layer names the EXR already uses: a light group may not take one.
-const RESERVED: [&str; 9] = [
+const RESERVED: [&str; 10] = [
     "albedo",
     "depth",
     "direct",
@@ -27,6 +27,7 @@ const RESERVED: [&str; 9] = [
     "noisy",
     "denoised",
     "blend",
+    crate::denoise_tiles::INPUT_LAYER,
     OBJECT_LAYER,
     ASSET_LAYER,
 ];

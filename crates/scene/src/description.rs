@@ -30,12 +30,13 @@ pub use crate::values::{
 declare_settings! {
     /// `[output]`: where the image goes.
     table output: OutputSpec, OutputFlags, one {
-    /// Output EXR (RGBA f32; alpha = 1 - camera-ray transmittance), written
-    /// whole or not at all.
+    /// Output image, its format told by its extension: OpenEXR (`.exr`:
+    /// RGBA f32, alpha = 1 - camera-ray transmittance, and the layers), or
+    /// a PNG (`.png`, as `--png`); written whole or not at all.
     output as "exr": PathBuf, flag(short, long),
         unset("none: a library caller keeps the image"),
         example(PathBuf::from("a.exr"));
-    /// Also write an sRGB PNG preview.
+    /// Also write an sRGB PNG preview (given alone: a PNG-only render).
     png: PathBuf, flag(long), example(PathBuf::from("a.png"));
     /// Exposure of the PNG preview, in stops.
     exposure: f32, flag(long, allow_hyphen_values = true), default(0.0), example(1.5);
@@ -135,7 +136,9 @@ declare_settings! {
     /// Denoise with Intel Open Image Denoise 2.x (guided by the albedo
     /// AOV), blended with the noisy image by their estimated errors; the
     /// EXR keeps the noisy image as `noisy.R/G/B`, the plain denoised one
-    /// as `denoised.R/G/B` and the blend's weights as `blend.weight`.
+    /// as `denoised.R/G/B` and the blend's weights as `blend.weight`. A
+    /// crop keeps the denoiser's inputs instead, and `cirrus merge`
+    /// denoises the whole image.
     denoise: bool, flag(long, num_args = 0, default_missing_value = "true"),
         default(false), example(true);
     /// Motion blur: the shutter's open and close times in frames around
@@ -179,7 +182,8 @@ declare_settings! {
     /// The camera's up direction.
     camera_up as "up": [f32; 3], serde(default, deserialize_with = "crate::parse::triple_field"), flag(long, value_parser = parse::vector, allow_hyphen_values = true),
         default([0.0, 1.0, 0.0]), example([0.0, 0.0, 1.0]);
-    /// Vertical field of view in degrees.
+    /// Vertical field of view in degrees, of the given camera or of the
+    /// one framed on the volumes.
     fov: f32, flag(long), default(40.0), example(25.0);
     @file_only {
         /// Camera to world, a 4x4 matrix (rows; column vectors, the
@@ -338,7 +342,7 @@ declare_settings! {
     /// Draine's alpha.
     draine_alpha: f32, flag(long), default(1.0), example(0.5);
     /// The vec3 velocity grid moving the volume while the shutter is open.
-    velocity: String, flag(long), unset("\"vel\" or \"v\" if the file has one"),
+    velocity: String, flag(long), unset("\"vel\", \"v\" or \"velocity\" if the file has one"),
         example("velocity".into());
     /// What velocity values measure: world units or velocity-grid voxels,
     /// per frame.

@@ -13,8 +13,9 @@ use crate::error::{Error, Result};
 /// The grid name looked for when none is given.
 pub const DENSITY_GRID: &str = "density";
 /// Velocity grids used when the shutter is open and none is named: the
-/// first vec3 grid with one of these names.
-pub const VELOCITY_GRIDS: [&str; 2] = ["vel", "v"];
+/// first vec3 grid with one of these names (Houdini writes `vel` or
+/// `velocity`, Blender's fluids `velocity`).
+pub const VELOCITY_GRIDS: [&str; 3] = ["vel", "v", "velocity"];
 
 /// The grid to render or convert: the one named, else "density", else
 /// the first float grid.
@@ -102,7 +103,7 @@ pub fn is_cbrk(path: &Path) -> bool {
 }
 
 /// The velocity grid of a moving volume: the one named (which must be a
-/// vec3 grid), else the first vec3 grid named `vel` or `v`
+/// vec3 grid), else the first vec3 grid named `vel`, `v` or `velocity`
 /// ([`VELOCITY_GRIDS`]), else none.
 pub fn choose_velocity(file: &VolumeFile, name: Option<&str>) -> Result<Option<usize>> {
     let grids = file.grids();

@@ -38,6 +38,7 @@ pub mod compositing;
 pub mod cull;
 mod declare;
 mod denoise;
+mod denoise_tiles;
 pub mod dense;
 pub mod description;
 mod error;
@@ -54,6 +55,7 @@ mod overrides;
 pub mod parse;
 mod plan;
 mod prepare;
+mod ranges;
 mod scene;
 mod settings;
 pub mod timeline;
@@ -62,6 +64,7 @@ mod values;
 
 pub use declare::{SettingInfo, Shown};
 pub use denoise::{denoise, denoise_available};
+pub use denoise_tiles::merge_tiles;
 #[cfg(feature = "clap")]
 #[cfg(feature = "clap")]
 pub use description::OutputFlags;
@@ -69,7 +72,7 @@ pub use description::SceneDescription;
 pub use error::{Error, ErrorKind, Result};
 #[cfg(feature = "clap")]
 pub use flags::{settings_table, SceneFlags};
-pub use output::{write_whole, Outputs};
+pub use output::{has_extension, write_whole, Outputs};
 pub use overrides::{examples, settings, Overrides};
 pub use plan::{VolumeCache, DENSITY_SCALE_PER_VOXEL};
 pub use prepare::{Placement, Prepared};

@@ -26,6 +26,9 @@ pub struct Outputs {
     pub cryptomatte: bool,
     pub deep: Option<PathBuf>,
     pub deep_samples: u32,
+    /// A crop of a denoised render: its EXR keeps the denoiser's inputs
+    /// for `cirrus merge`, which denoises the whole image.
+    pub denoise_at_merge: bool,
     /// Each volume's Cryptomatte name and asset, by its index in the scene.
     pub object_names: Vec<String>,
     pub asset_names: Vec<String>,
@@ -40,11 +43,19 @@ impl Outputs {
             cryptomatte: o.cryptomatte() || aovs.contains(&Aov::Cryptomatte),
             deep: o.deep.clone(),
             deep_samples: o.deep_samples(),
+            denoise_at_merge: desc.render.denoise.unwrap_or(false) && o.crop.is_some(),
             // A clash of names is refused before rendering (Scene::render).
             object_names: crate::compositing::instance_names(desc).unwrap_or_default(),
             asset_names: crate::compositing::asset_names(desc),
-            exr: o.output.clone(),
-            png: o.png.clone(),
+            // `-o NAME.png` alone is a PNG-only render.
+            exr: o
+                .output
+                .clone()
+                .filter(|p| o.png.is_some() || !has_extension(p, "png")),
+            png: o
+                .png
+                .clone()
+                .or_else(|| o.output.clone().filter(|p| has_extension(p, "png"))),
             exposure: o.exposure(),
             stats: o.stats.clone(),
             aovs: o.aov.clone().unwrap_or_default(),
@@ -61,6 +72,41 @@ impl Outputs {
         }
     }
 
+    /// Refuses a file whose extension names another format than the one
+    /// it would be written in: the format is told by the extension.
+    pub fn check(&self) -> Result<()> {
+        if let Some(p) = &self.exr {
+            if !has_extension(p, "exr") {
+                let why = match has_extension(p, "png") {
+                    true => "-o names a PNG and --png another: give the PNG once",
+                    false => "-o writes OpenEXR (.exr) or PNG (.png), told by the extension; name the file .exr or .png",
+                };
+                return Err(Error::input(format!("{}: {why}", p.display())));
+            }
+        }
+        for (path, flag, ext, format) in [
+            (&self.png, "--png", "png", "PNG"),
+            (&self.deep, "--deep", "exr", "deep OpenEXR"),
+        ] {
+            if let Some(p) = path.as_ref().filter(|p| !has_extension(p, ext)) {
+                return Err(Error::input(format!(
+                    "{}: {flag} writes {format}; name the file .{ext}",
+                    p.display()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The files [`Outputs::write`] writes, in the order it writes them.
+    pub fn files(&self) -> Vec<&Path> {
+        [&self.deep, &self.exr, &self.png, &self.stats]
+            .into_iter()
+            .flatten()
+            .map(|p| p.as_path())
+            .collect()
+    }
+
     /// Writes every output that is set.
     pub fn write(&self, rendered: &Rendered) -> Result<()> {
         let file_err = |p: &Path, e: std::io::Error| Error::file(format!("{}: {e}", p.display()));
@@ -71,7 +117,12 @@ impl Outputs {
         if let Some(exr) = &self.exr {
             let aovs = crate::compositing::written_aovs(&self.aovs, rendered.layers.as_ref());
             let names = [&self.object_names[..], &self.asset_names[..]];
-            let (extra, attributes) = crate::compositing::layer_channels(rendered, names);
+            let (mut extra, mut attributes) = crate::compositing::layer_channels(rendered, names);
+            if self.denoise_at_merge {
+                let (inputs, groups) = crate::denoise_tiles::input_channels(rendered)?;
+                extra.extend(inputs);
+                attributes.extend(groups);
+            }
             write_exr_with(exr, rendered, &aovs, extra, attributes)
                 .map_err(|e| file_err(exr, e))?;
         }
@@ -84,6 +135,13 @@ impl Outputs {
         }
         Ok(())
     }
+}
+
+/// Whether `path` ends in `.ext`, in any case.
+pub fn has_extension(path: &Path, ext: &str) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
 /// Writes a file whole or not at all: a temporary beside it, then a rename.

@@ -155,6 +155,9 @@ pub fn plan(
         (true, false) => choose_velocity(files.open(&path)?, v.velocity.as_deref())?,
         _ => None,
     };
+    if let Some(w) = velocity_warning(v, moving, cbrk, velocity, files)? {
+        files.warnings.push(w);
+    }
     let velocity_scale = v.velocity_scale();
     if !velocity_scale.is_finite() {
         return Err(Error::input(format!(
@@ -187,6 +190,59 @@ pub fn plan(
             * v.emission_scale.unwrap_or(1.0),
         holdout: v.holdout.unwrap_or(false),
     })
+}
+
+/// What to say when the shutter is open and a volume's density cannot
+/// move: no velocity grid was found (the file's vector grids listed, any
+/// of which `--velocity` can name), or a `.cbrk` holds none.
+fn velocity_warning(
+    v: &VolumeSpec,
+    moving: bool,
+    cbrk: bool,
+    found: Option<usize>,
+    files: &mut VolumeCache,
+) -> Result<Option<String>> {
+    let path = v.file.display();
+    if !moving {
+        return Ok(None);
+    }
+    // A time-sampled transform moves the volume whole: no velocity needed.
+    if found.is_some() || v.transform.samples.is_some() {
+        return Ok(None);
+    }
+    if cbrk {
+        return Ok(Some(format!(
+            "{path}: the shutter is open but a .cbrk holds no velocity grid: no motion blur \
+             (render the .vdb for it)"
+        )));
+    }
+    let vectors = vector_grids(files.open(&v.file)?);
+    let listed = match vectors.is_empty() {
+        true => "the file has no vector grid".to_string(),
+        false => format!(
+            "its vector grids: {}; name one with --velocity NAME",
+            vectors.join(", ")
+        ),
+    };
+    Ok(Some(format!(
+        "{path}: the shutter is open but no velocity grid was found (looked for {}): its \
+         density does not move (no motion blur from it); {listed}",
+        crate::grids::VELOCITY_GRIDS.join(", ")
+    )))
+}
+
+/// The names of a file's vec3 grids.
+fn vector_grids(f: &VolumeFile) -> Vec<String> {
+    f.grids()
+        .iter()
+        .filter(|g| {
+            matches!(
+                g.value_type,
+                Some(cirrus_vdb::ValueType::Vec3f | cirrus_vdb::ValueType::Vec3d)
+            )
+        })
+        .map(|g| format!("{:?}", g.name))
+        .collect()
 }
 
 /// The phase function a volume names, with the defaults filled in.
@@ -234,6 +290,9 @@ pub struct VolumeCache {
     grids: HashMap<GridKey, BrickVolume>,
     velocities: HashMap<(PathBuf, usize), Arc<VelocityGrid>>,
     cbrk_bytes: u64,
+    /// What planning and loading found wrong but could render, not yet
+    /// handed to a prepared scene.
+    pub(crate) warnings: Vec<String>,
     /// The pose tables and shells of the last prepared scene's moving
     /// volumes, per kept volume (`moving.rs`).
     pub(crate) poses: Vec<Option<Pose>>,
@@ -266,6 +325,15 @@ impl VolumeCache {
                     GridPrecision::Render => read_render_bricks(f, index)?,
                 }
             };
+            let bad = volume.info.sanitized_voxels;
+            if bad > 0 {
+                self.warnings.push(format!(
+                    "{}: grid {:?}: {bad} voxels are NaN, infinite or negative; they render \
+                     as density 0 (empty space)",
+                    path.display(),
+                    volume.info.grid_name
+                ));
+            }
             self.grids.insert(key.clone(), volume);
         }
         Ok(&self.grids[&key])

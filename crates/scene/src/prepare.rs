@@ -49,6 +49,11 @@ pub struct Prepared<'c> {
     pub settings: RenderSettings,
     /// The world position of render space's origin.
     pub centre: DVec3,
+    /// Whether the camera was framed on the volumes (none was given).
+    pub framed: bool,
+    /// What loading found wrong but could render (bad voxels, an open
+    /// shutter with no velocity grid), each said once.
+    pub warnings: Vec<String>,
     /// Volumes neither the camera nor any light path can reach (not loaded).
     pub culled: u64,
     /// The scene's index of each instance rendered.
@@ -69,6 +74,16 @@ impl Prepared<'_> {
         s.grids_loaded = self.grids_loaded;
         s.volumes_culled = self.culled;
         s.load_seconds = self.load_seconds;
+        s.warnings = self.warnings.clone();
+        let c = &self.scene.camera;
+        let world = |p: glam::Vec3| (p.as_dvec3() + self.centre).to_array();
+        s.camera = Some(cirrus_render::CameraReport {
+            from: world(c.from()),
+            to: world(c.to()),
+            up: c.up().to_array(),
+            fov: c.vfov_degrees(),
+            framed: self.framed,
+        });
         rendered
     }
 }
@@ -98,7 +113,9 @@ pub fn prepare<'c>(
         .map(|v| plan(v, cache, moving, placement.precision()))
         .collect::<Result<Vec<_>>>()?;
     let (boxes, centre, framed) = render_space(placement, cache, &plans)?;
-    let camera = match crate::moving::camera(desc, &settings, centre)? {
+    let placed = crate::moving::camera(desc, &settings, centre)?;
+    let framed_camera = placed.is_none() && settings.look_at.is_none();
+    let camera = match placed {
         Some(c) => c,
         None => camera(&settings, centre, framed),
     };
@@ -131,6 +148,7 @@ pub fn prepare<'c>(
     // Moving volumes' pose tables and the shells bounding their poses,
     // kept by the cache for as long as this scene borrows it.
     cache.poses = crate::moving::poses(cache, kept(), centre)?;
+    let warnings = std::mem::take(&mut cache.warnings);
     let cache: &'c VolumeCache = cache;
     let instances = kept()
         .zip(&cache.poses)
@@ -152,6 +170,8 @@ pub fn prepare<'c>(
         },
         settings: settings.render,
         centre,
+        framed: framed_camera,
+        warnings,
         culled: keep.iter().filter(|k| !**k).count() as u64,
         kept: (0..keep.len()).filter(|&i| keep[i]).collect(),
         bytes_read: cache.bytes_read(),
@@ -233,7 +253,7 @@ fn camera(s: &SceneSettings, centre: DVec3, framed: Bounds3) -> Camera {
     let (w, h) = s.res;
     match s.look_at {
         Some((from, to)) => Camera::new(to_render(from), to_render(to), s.camera_up, s.fov, w, h),
-        None => Camera::framing(framed, w, h),
+        None => Camera::framing_with_fov(framed, w, h, s.fov),
     }
 }
 

@@ -30,8 +30,13 @@ use crate::settings::SceneSettings;
 pub struct Scene {
     description: SceneDescription,
     placement: Placement,
-    /// Draw a progress bar on a terminal's stderr while rendering.
+    /// Show progress on stderr while rendering: a bar on a terminal,
+    /// plain lines every few seconds on anything else (a log).
     pub progress_bar: bool,
+    /// Print what loading found wrong (bad voxels, an open shutter with
+    /// no velocity) on stderr as it is found, before the render; it is in
+    /// the statistics' `warnings` either way.
+    pub warn_on_stderr: bool,
     /// What the scene's reader could not render (a USD stage's meshes...).
     warnings: Vec<String>,
 }
@@ -66,6 +71,7 @@ impl Scene {
             },
             placement: Placement::OwnGrid,
             progress_bar: false,
+            warn_on_stderr: false,
             warnings: Vec::new(),
         }
     }
@@ -83,6 +89,7 @@ impl Scene {
             description,
             placement: Placement::Volumes,
             progress_bar: false,
+            warn_on_stderr: false,
             warnings: Vec::new(),
         })
     }
@@ -157,13 +164,28 @@ impl Scene {
         cache: &mut VolumeCache,
         control: Option<Arc<RenderControl>>,
     ) -> Result<Rendered> {
-        let mut rendered = self.prepare(cache, control.clone())?.render();
+        let prepared = self.prepare(cache, control.clone())?;
+        if self.warn_on_stderr {
+            for w in &prepared.warnings {
+                eprintln!("cirrus: warning: {w}");
+            }
+        }
+        let mut rendered = prepared.render();
         if control.as_ref().is_some_and(|c| c.is_cancelled()) {
             return Err(Error::cancelled());
         }
         refuse_all_dropped(&rendered.stats.counters)?;
+        // A crop is denoised where the whole image exists, at the merge
+        // (denoise_tiles.rs): it keeps the denoiser's inputs instead.
         if self.description.render.denoise.unwrap_or(false) {
-            crate::denoise::denoise(&mut rendered)?;
+            match self.outputs().crop {
+                None => crate::denoise::denoise(&mut rendered)?,
+                Some(_) => rendered.stats.warnings.push(
+                    "a crop is not denoised alone: its EXR keeps the denoiser's inputs and \
+                     `cirrus merge` denoises the whole image"
+                        .into(),
+                ),
+            }
         }
         Ok(rendered)
     }
@@ -176,8 +198,9 @@ impl Scene {
         cache: &'c mut VolumeCache,
         control: Option<Arc<RenderControl>>,
     ) -> Result<Prepared<'c>> {
-        let mut settings = self.settings()?;
         let outputs = self.outputs();
+        outputs.check()?;
+        let mut settings = self.settings()?;
         let denoise = self.description.render.denoise.unwrap_or(false);
         let r = &mut settings.render;
         r.crop = outputs.crop;

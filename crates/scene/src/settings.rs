@@ -25,6 +25,7 @@ pub struct SceneSettings {
 impl SceneSettings {
     /// Resolves `desc` (the sky map, if any, is read here).
     pub fn resolve(desc: &SceneDescription) -> Result<SceneSettings> {
+        crate::ranges::check(desc)?;
         let c = &desc.camera;
         let look_at = match (c.camera_from, c.camera_to) {
             (Some(f), Some(t)) => Some((DVec3::from_array(f), DVec3::from_array(t))),

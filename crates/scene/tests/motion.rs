@@ -46,10 +46,42 @@ fn a_closed_shutter_renders_bit_identical_to_no_motion_blur() {
         ..Default::default()
     };
     let a = lone(random(None)).unwrap();
-    // An open shutter on a file with no default-named velocity grid
-    // ("velocity" is named only when asked for): nothing moves.
-    let b = lone(random(Some([-0.5, 0.5]))).unwrap();
+    let b = lone(Overrides {
+        shutter: Some([0.0, 0.0]),
+        ..random(None)
+    })
+    .unwrap();
     assert_eq!(bits(&a.image.rgba), bits(&b.image.rgba));
+}
+
+#[test]
+fn a_velocity_grid_called_velocity_is_found_and_a_missing_one_is_warned_about() {
+    let open = |velocity: Option<&str>| Overrides {
+        shutter: Some([-0.5, 0.5]),
+        velocity: velocity.map(String::from),
+        ..Default::default()
+    };
+    // Houdini's and Blender's name: used without being named.
+    let named = lone(open(Some("velocity"))).unwrap();
+    let found = lone(open(None)).unwrap();
+    assert_eq!(bits(&found.image.rgba), bits(&named.image.rgba));
+    assert!(
+        found.stats.warnings.is_empty(),
+        "{:?}",
+        found.stats.warnings
+    );
+    let still = lone(Overrides::default()).unwrap();
+    assert_ne!(bits(&found.image.rgba), bits(&still.image.rgba), "it blurs");
+    // A file with no vector grid renders still, and says why.
+    let mut scene = Scene::load(Path::new(&data("cloud.vdb"))).unwrap();
+    scene.apply(&small());
+    scene.apply(&open(None));
+    let r = scene.render().unwrap();
+    let w = r.stats.warnings.join("\n");
+    assert!(
+        w.contains("cloud.vdb") && w.contains("no velocity grid") && w.contains("no vector grid"),
+        "{w}"
+    );
 }
 
 #[test]

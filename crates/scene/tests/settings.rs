@@ -58,7 +58,12 @@ fn every_setting_with_a_flag_has_an_example() {
 fn context(keyword: &str) -> Overrides {
     let mut o = Overrides::default();
     match keyword {
-        "min_spp" => o.noise_threshold = Some(0.05),
+        // Adaptive sampling's most samples (spp) at least its fewest.
+        "min_spp" => {
+            o.noise_threshold = Some(0.05);
+            o.spp = Some(32);
+        }
+        "noise_threshold" => o.spp = Some(32),
         "step" | "shadow_step" => o.integrator = Some(cirrus_render::IntegratorKind::RayMarch),
         "g2" | "lobe_weight" => o.phase = Some("hg2".into()),
         "droplet_diameter" => o.phase = Some("mie".into()),
@@ -146,7 +151,32 @@ fn handed(scene: &Scene) -> String {
     s
 }
 
-/// A 6x4 image of `file` (in data/) from a fixed camera.
+/// The name `renamed_velocity()` gives multi_grid.vdb's "velocity" grid:
+/// of the same length, so the file's layout is unchanged.
+const RENAMED_VELOCITY: &str = "motion_v";
+
+/// multi_grid.vdb with its velocity grid renamed, so that no grid has a
+/// name looked for by default; written once.
+fn renamed_velocity() -> PathBuf {
+    let path = std::env::temp_dir().join(format!("cirrus-settings-{}.vdb", std::process::id()));
+    if !path.exists() {
+        let mut bytes = std::fs::read(repo().join("data/multi_grid.vdb")).unwrap();
+        let (from, to) = (b"velocity", RENAMED_VELOCITY.as_bytes());
+        let mut renamed = 0;
+        for i in 0..bytes.len().saturating_sub(from.len()) {
+            if &bytes[i..i + from.len()] == from {
+                bytes[i..i + from.len()].copy_from_slice(to);
+                renamed += 1;
+            }
+        }
+        assert!(renamed > 0);
+        std::fs::write(&path, bytes).unwrap();
+    }
+    path
+}
+
+/// A 6x4 image of `file` (in data/, or an absolute path) from a fixed
+/// camera.
 fn base_scene(file: &str) -> Scene {
     let data = repo().join("data");
     let base = format!(
@@ -177,14 +207,24 @@ fn every_setting_reaches_the_renderer() {
         }
         // A file with a velocity grid, or for the grid's choice one with
         // two density-like grids.
+        let renamed = renamed_velocity();
         let file = match keyword {
             "grid" => "fireball.vdb",
+            // multi_grid.vdb's "velocity" is found unnamed; a grid of
+            // another name is not.
+            "velocity" => renamed.to_str().unwrap(),
             _ => "multi_grid.vdb",
         };
         let mut before = base_scene(file);
         before.apply(&context(keyword));
         let mut after = before.clone();
         after.apply(&example);
+        if keyword == "velocity" {
+            after.apply(&Overrides {
+                velocity: Some(RENAMED_VELOCITY.into()),
+                ..Default::default()
+            });
+        }
         if keyword == "holdout_depth" {
             // The declared example names no file here: the one written.
             after.apply(&Overrides {
@@ -236,4 +276,49 @@ fn the_render_crates_defaults_are_the_declared_ones() {
         img.rgba.iter().flatten().map(|v| v.to_bits()).collect()
     };
     assert_eq!(bits(&a), bits(&b));
+}
+
+/// The keys `data/scene_example.toml` shows, set or commented out, by
+/// table: a line `key = ...` (after an optional `# `) under `[table]` or
+/// `[[table]]` (itself perhaps commented out).
+fn example_keys(text: &str) -> Vec<(String, String)> {
+    let mut table = String::new();
+    let mut keys = Vec::new();
+    for line in text.lines() {
+        let line = line.trim_start_matches('#').trim();
+        if line.starts_with('[') {
+            let name = line.trim_matches(|c| c == '[' || c == ']');
+            if name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                table = name.to_string();
+            }
+            continue;
+        }
+        let Some((key, _)) = line.split_once('=') else {
+            continue;
+        };
+        let key = key.trim();
+        if !key.is_empty() && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            keys.push((table.clone(), key.to_string()));
+        }
+    }
+    keys
+}
+
+#[test]
+fn the_example_scene_names_every_setting_and_renders_as_read() {
+    let path = repo().join("data/scene_example.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let shown = example_keys(&text);
+    let missing: Vec<String> = settings()
+        .iter()
+        .filter(|s| !shown.iter().any(|(t, k)| t == s.table && k == s.key))
+        .map(|s| format!("[{}] {}", s.table, s.key))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "data/scene_example.toml, the commented reference, lacks: {}",
+        missing.join(", ")
+    );
+    // And what it sets (uncommented) is a valid scene.
+    cirrus_scene::SceneDescription::read(&path).unwrap();
 }

@@ -568,3 +568,26 @@ fn light_values_past_f32_are_refused_naming_the_stage_prim_and_value() {
         );
     }
 }
+
+#[test]
+fn a_distant_light_too_dim_to_see_is_warned_about() {
+    let d = dir("dim_sun");
+    // UsdLux: without `normalize`, intensity 2 is the radiance of a
+    // 0.53-degree disk, 2 pi sin^2(0.265 deg) = 1.3e-4 W/m^2.
+    let warnings = |normalize: &str| {
+        let light = format!(
+            "    def DistantLight \"Sun\"\n    {{\n        float inputs:intensity = 2\n{normalize}    }}\n"
+        );
+        let body = format!("{}{light}", volume("Cloud", "./cloud.vdb", "density"));
+        let p = write(&d, "shot.usda", &stage(&body));
+        Scene::load(&p).unwrap().warnings().join("\n")
+    };
+    let w = warnings("");
+    assert!(
+        w.contains("/World/Sun: irradiance 1.344e-4 W/m^2 lights nothing visibly")
+            && w.contains("inputs:normalize = 1"),
+        "{w}"
+    );
+    let w = warnings("        bool inputs:normalize = 1\n");
+    assert!(!w.contains("/World/Sun"), "{w}");
+}

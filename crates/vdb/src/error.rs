@@ -21,7 +21,9 @@ pub enum ErrorKind {
     Corrupt(String),
     #[error("unsupported {0}")]
     Unsupported(String),
-    #[error("no grid named {0:?} in the file")]
+    /// The grid asked for, as said (a quoted name and the file's grids,
+    /// or an index and the count).
+    #[error("no grid {0}")]
     NoSuchGrid(String),
 }
 

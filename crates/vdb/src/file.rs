@@ -237,7 +237,11 @@ impl VolumeFile {
             .iter()
             .position(|g| g.unique_name == name)
             .or_else(|| grids.iter().position(|g| g.name == name))
-            .ok_or_else(|| Error::new(self.path(), ErrorKind::NoSuchGrid(name.to_string())))
+            .ok_or_else(|| {
+                let names: Vec<String> = grids.iter().map(|g| format!("{:?}", g.name)).collect();
+                let said = format!("named {name:?} (grids: {})", names.join(", "));
+                Error::new(self.path(), ErrorKind::NoSuchGrid(said))
+            })
     }
 
     pub fn read_grid_by_name(&self, name: &str) -> Result<Grid> {

@@ -24,6 +24,13 @@ pub struct ConvertArgs {
 
 pub fn run(args: &ConvertArgs) -> CliResult {
     let precision = Precision::from_name(&args.precision).expect("clap checked the name");
+    if !cirrus_scene::has_extension(&args.output, "cbrk") {
+        return Err(format!(
+            "{}: convert writes bricks (.cbrk); name the output OUT.cbrk",
+            args.output.display()
+        )
+        .into());
+    }
     let file = VolumeFile::open(&args.input)?;
     let index = choose_grid(&file, args.grid.as_deref())?;
     // Streamed: a .vdb grid goes into bricks without the reader's tree.
@@ -38,7 +45,7 @@ pub fn run(args: &ConvertArgs) -> CliResult {
     let write_s = start.elapsed().as_secs_f64();
     let i = &volume.info;
     eprintln!(
-        "{}: grid {:?}, {} active voxels -> {} bricks stored, {} constant, {} empty ({} precision, max error {:e}); read and converted {:.3} s ({:.1} M active voxels/s), written {:.3} s, {} bytes",
+        "{}: grid {:?}, {} active voxels -> {} bricks stored, {} constant, {} empty ({} precision, max error {}); read and converted {:.3} s ({:.1} M active voxels/s), written {:.3} s, {} bytes",
         args.output.display(),
         i.grid_name,
         i.active_voxels,
@@ -46,7 +53,10 @@ pub fn run(args: &ConvertArgs) -> CliResult {
         i.bricks_constant,
         i.bricks_empty,
         precision.name(),
-        i.max_error,
+        match i.max_error {
+            0.0 => "0, exact".to_string(),
+            e => format!("{e:.3e}"),
+        },
         convert_s,
         i.active_voxels as f64 / convert_s.max(1e-9) / 1e6,
         write_s,

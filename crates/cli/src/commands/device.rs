@@ -55,6 +55,11 @@ impl Target {
         };
         let mut cache = VolumeCache::default();
         let prepared = scene.prepare(&mut cache, None)?;
+        if scene.warn_on_stderr {
+            for w in &prepared.warnings {
+                eprintln!("cirrus: warning: {w}");
+            }
+        }
         match cirrus_gpu::render(gpu, &prepared.scene, &prepared.settings) {
             Ok(mut rendered) => {
                 if let Some(means) = cirrus_gpu::substitutions(&prepared.settings) {

@@ -62,16 +62,16 @@ fn print_table(r: &Json) {
             (
                 "type",
                 format!(
-                    "{} {}{}",
+                    "{}{}",
                     g["value_type"],
-                    g["class"],
                     if g["half_float"] == true {
-                        " (half)"
+                        " (stored as half floats)"
                     } else {
                         ""
                     }
                 ),
             ),
+            ("class", class_of(&g["class"])),
             ("active voxels", g["active_voxels"].to_string()),
             (
                 "leaves / tiles",
@@ -102,6 +102,23 @@ fn print_table(r: &Json) {
     }
 }
 
+/// A grid's class as OpenVDB's `class` metadata says, or that it says none.
+fn class_of(class: &Json) -> String {
+    match class.as_str() {
+        Some("unknown") | None => "not set (OpenVDB's GRID_UNKNOWN)".into(),
+        Some(c) => c.into(),
+    }
+}
+
+/// The largest absolute difference from the source's values.
+fn max_error(e: &Json) -> String {
+    match e.as_f64() {
+        Some(0.0) => "0 (exact)".into(),
+        Some(e) => format!("{e:.3e}"),
+        None => e.to_string(),
+    }
+}
+
 /// `cirrus info OUT.cbrk`: what the conversion kept and what it costs.
 fn print_cbrk(r: &Json) {
     let b = &r["bytes"];
@@ -116,7 +133,7 @@ fn print_cbrk(r: &Json) {
         "  bricks           {} stored, {} constant, {} skipped (empty)",
         r["bricks_stored"], r["bricks_constant"], r["bricks_skipped"]
     );
-    println!("  max error        {}", r["max_error"]);
+    println!("  max error        {}", max_error(&r["max_error"]));
     println!(
         "  bytes            map {}, tables {}, atlas {}, levels {}, total {}",
         b["map"], b["constants_and_ranges"], b["atlas"], b["levels"], b["total"]

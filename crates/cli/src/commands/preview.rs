@@ -1,4 +1,4 @@
-//! `cirrus preview FILE|SCENE.toml [--port P] [--bind ADDR]`: serves a
+//! `cirrus preview FILE|SCENE.toml|STAGE.usd [--port P] [--bind ADDR]`: serves a
 //! live progressive render to the browser (`cirrus-preview`) and prints
 //! its URL.
 
@@ -8,7 +8,9 @@ use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct PreviewArgs {
-    /// A .vdb, .nvdb or .cbrk volume, or a scene file (.toml, with a camera).
+    /// A .vdb, .nvdb or .cbrk volume, a scene file (.toml) or a USD stage
+    /// (.usd, .usda, .usdc, .usdz); without a camera the view is framed on
+    /// the volumes.
     pub file: PathBuf,
     /// Port to listen on (0: any free port).
     #[arg(long, default_value_t = 8470)]

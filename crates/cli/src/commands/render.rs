@@ -2,6 +2,7 @@
 //! the scene library, renders, writes the outputs and prints a summary;
 //! with `--frames` (or a scene file's `[render] frames`), once per frame.
 
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use super::device::{parse_device, Target};
@@ -52,10 +53,18 @@ pub fn run(args: &RenderArgs) -> CliResult {
     match range {
         None => {
             let scene = load(file, &overrides, None)?;
+            warn_unused_velocity(&scene, &overrides);
             render_one(&scene, &target, true)?;
             Ok(())
         }
-        Some(range) => sequence(file, &overrides, range, args.overwrite, &target),
+        Some(range) => {
+            // A scene file that cannot be read is reported per frame.
+            if let Ok(scene) = load(file, &overrides, None) {
+                outputs_tell_frames_apart(&scene, &range)?;
+                warn_unused_velocity(&scene, &overrides);
+            }
+            sequence(file, &overrides, range, args.overwrite, &target)
+        }
     }
 }
 
@@ -91,6 +100,40 @@ fn frame_range(
         .transpose()?)
 }
 
+/// `--velocity NAME` moves nothing while the shutter is closed: said,
+/// since the flag was given to blur.
+fn warn_unused_velocity(scene: &Scene, overrides: &Overrides) {
+    let [open, close] = scene.description().render.shutter();
+    if let (Some(name), true) = (&overrides.velocity, open == close) {
+        eprintln!(
+            "cirrus: warning: --velocity {name}: unused while the shutter is closed; open it \
+             (--shutter -0.25,0.25) for motion blur"
+        );
+    }
+}
+
+/// Several frames need outputs with a frame pattern: without one each
+/// frame would write the same file (and, the file existing, the next
+/// frames would be skipped as finished).
+fn outputs_tell_frames_apart(scene: &Scene, range: &FrameRange) -> CliResult {
+    if range.count() < 2 {
+        return Ok(());
+    }
+    let outputs = scene.outputs();
+    for path in outputs.files() {
+        if !has_pattern(&path.to_string_lossy()) {
+            return Err(format!(
+                "{}: {} frames would all be written to this one file; put a frame pattern \
+                 in it (out.####.exr or out.%04d.exr)",
+                path.display(),
+                range.count()
+            )
+            .into());
+        }
+    }
+    Ok(())
+}
+
 /// The scene of `file` with the flags applied, for one frame or none.
 fn load(file: &Path, overrides: &Overrides, frame: Option<i64>) -> cirrus_scene::Result<Scene> {
     let path = frame.map_or_else(|| file.to_path_buf(), |f| substitute(file, f));
@@ -102,24 +145,40 @@ fn load(file: &Path, overrides: &Overrides, frame: Option<i64>) -> cirrus_scene:
     })
 }
 
-/// Renders and writes one scene; `bar`: draw the render's own progress bar.
+/// Renders and writes one scene on `target`; `bar`: show the render's
+/// progress (a bar on a terminal, plain lines in a log). Returns the
+/// first file written.
 fn render_one(
     scene: &Scene,
     target: &Target,
     bar: bool,
 ) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let outputs = scene.outputs();
-    let Some(exr) = outputs.exr.clone() else {
+    let Some(first) = outputs.exr.clone().or_else(|| outputs.png.clone()) else {
         return Err(
-            "an output file is required: -o OUT.exr (or [output] exr = \"...\" in a scene file)"
+            "an output file is required: -o OUT.exr, -o OUT.png or --png OUT.png \
+             (or [output] exr = \"...\" in a scene file)"
                 .into(),
         );
     };
     for warning in scene.warnings() {
         eprintln!("cirrus: warning: {warning}");
     }
+    match (outputs.denoise_at_merge, &outputs.exr) {
+        (false, _) => {}
+        (true, Some(exr)) => eprintln!(
+            "cirrus: a crop is denoised over the whole image by `cirrus merge`: {} keeps the \
+             noisy image and the denoiser's inputs",
+            exr.display()
+        ),
+        (true, None) => eprintln!(
+            "cirrus: warning: a crop is denoised over the whole image by `cirrus merge`, from \
+             its EXR; this PNG-only crop stays noisy"
+        ),
+    }
     let mut scene = scene.clone();
     scene.progress_bar = bar;
+    scene.warn_on_stderr = true;
     let rendered = target.render(&scene)?;
     for warning in Scene::render_warnings(&rendered) {
         eprintln!("cirrus: warning: {warning}");
@@ -131,8 +190,14 @@ fn render_one(
         );
     }
     outputs.write(&rendered)?;
-    summary(&exr, &rendered);
-    Ok(exr)
+    summary(&first, &rendered);
+    let files: Vec<String> = outputs
+        .files()
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    eprintln!("wrote {}", files.join(", "));
+    Ok(first)
 }
 
 /// Every frame of `range`: frames whose EXR exists are skipped unless
@@ -157,11 +222,15 @@ fn sequence(
         let result = load(file, overrides, Some(frame))
             .map_err(|e| e.into())
             .and_then(|scene| {
-                let done = scene.outputs().exr.filter(|p| p.exists() && !overwrite);
+                let outputs = scene.outputs();
+                let first = outputs.exr.or(outputs.png);
+                let done = first.filter(|p| p.exists() && !overwrite);
+                // In a log (no terminal) each frame reports its progress.
+                let lines = !std::io::stderr().is_terminal();
                 match done {
                     Some(_) => Ok(false),
                     None => bar
-                        .suspend(|| render_one(&scene, target, false))
+                        .suspend(|| render_one(&scene, target, lines))
                         .map(|_| true),
                 }
             });
@@ -186,18 +255,53 @@ fn sequence(
     Ok(())
 }
 
-fn summary(exr: &Path, rendered: &Rendered) {
+fn summary(first: &Path, rendered: &Rendered) {
     let s = &rendered.stats;
+    // With adaptive sampling pixels stop at different counts.
+    let spp = match s.spp_min == s.spp_max {
+        true => format!("{} spp", s.spp_max),
+        false => format!(
+            "{:.1} spp on average ({}-{})",
+            s.spp_mean, s.spp_min, s.spp_max
+        ),
+    };
     eprintln!(
-        "{}: {}x{} at {} spp in {:.2} s ({:.0} paths/s; {} real, {} null collisions; load {:.2} s)",
-        exr.display(),
+        "{}: {}x{} at {spp} in {:.2} s ({:.0} paths/s; {} real, {} null collisions; load {:.2} s)",
+        first.display(),
         s.width,
         s.height,
-        s.spp,
         s.wall_seconds,
         s.rays_per_second,
         s.counters.real_collisions,
         s.counters.null_collisions,
         s.load_seconds
     );
+    if s.counters.collision_cap_hits > 0 {
+        eprintln!(
+            "cirrus: warning: {} tracking calls hit the cap of {} collisions (a density far \
+             above the rest, such as 1e30): those rays ended carrying no light, so the image is \
+             darker there; see the largest values with `cirrus info --stats`",
+            s.counters.collision_cap_hits,
+            cirrus_render::kernel::tracking::MAX_COLLISIONS
+        );
+    }
+    if let Some(c) = s.camera.as_ref().filter(|c| c.framed) {
+        let point = |p: [f64; 3]| format!("{},{},{}", short(p[0]), short(p[1]), short(p[2]));
+        eprintln!(
+            "camera framed on the volumes: --camera-from {} --camera-to {} --fov {}",
+            point(c.from),
+            point(c.to),
+            c.fov
+        );
+    }
+}
+
+/// A coordinate to four decimals, without trailing zeros.
+fn short(x: f64) -> String {
+    let s = format!("{x:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    match s {
+        "-0" => "0".into(),
+        s => s.into(),
+    }
 }

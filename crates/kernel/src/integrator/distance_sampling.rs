@@ -7,8 +7,9 @@ use crate::medium::Media;
 settings_enum! {
     /// How the path tracer samples where light scatters along a ray.
     pub enum DistanceSampling {
-        /// `equiangular` where the media are thin (under
-        /// [`THIN_OPTICAL_DEPTH`] across), free flights alone otherwise.
+        // "3 mean free paths" is THIN_OPTICAL_DEPTH.
+        /// `equiangular` where the media are thin (under 3 mean free paths
+        /// across at their densest), free flights alone otherwise.
         #[default]
         Auto = "auto",
         /// Free flights, and equi-angular sampling toward sphere, point and

@@ -12,10 +12,10 @@ settings_enum! {
         Auto = "auto",
         /// Every light, one sample each.
         All = "all",
+        // Past 8 lights the pick is many_lights.rs's.
         /// One light (or, deep in the media, most often none), picked in
         /// proportion to its in-scattered radiance at the vertex seen through
-        /// the media (past 8 lights, by what each sends toward the vertex:
-        /// `many_lights.rs`).
+        /// the media (past 8 lights, by what each sends toward the vertex).
         One = "one",
         /// One light picked uniformly at random (the baseline the weighed
         /// pick is measured against).

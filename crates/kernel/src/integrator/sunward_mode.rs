@@ -6,12 +6,14 @@ use crate::phase::Phase;
 settings_enum! {
     /// Where sunward scattering runs.
     pub enum Sunward {
-        /// At vertices whose phase function's mean cosine is at least
-        /// [`FORWARD_MEAN_COSINE`].
+        // 0.6 is FORWARD_MEAN_COSINE.
+        /// At vertices whose phase function's mean cosine is at least 0.6
+        /// (forward scattering, where it was measured to pay).
         #[default]
         Auto = "auto",
         /// At every vertex under a sun.
         On = "on",
+        /// Never.
         Off = "off",
     }
 }

@@ -58,8 +58,9 @@ settings_enum! {
 settings_enum! {
     /// Which majorants the trackers use.
     pub enum MajorantMode {
-        /// Whichever of the two a probe of the scene finds cheaper (the
-        /// host renders the probe: `cirrus_render::majorant_choice`).
+        // The host renders the probe (cirrus_render::majorant_choice).
+        /// Whichever of the two a probe of about a thousand paths of the
+        /// scene finds cheaper (`--stats` says which).
         #[default]
         Auto = "auto",
         /// The field's own local segments (its hierarchy or grid).

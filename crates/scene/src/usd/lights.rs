@@ -82,6 +82,11 @@ fn checked(r: &Reader, path: &str, spec: LightSpec) -> Result<LightSpec> {
     Ok(spec)
 }
 
+/// Below this irradiance (W/m^2, a 250th of the default sun's) a distant
+/// light lights nothing a render shows; a stage's light that weak is
+/// most often one authored for `normalize` without it.
+const DIM_IRRADIANCE: f32 = 0.01;
+
 /// The sun of the `DistantLight` at `path`.
 pub fn distant(r: &mut Reader, path: &str) -> Result<SunSpec> {
     let p = r.stage.prim(path);
@@ -95,6 +100,20 @@ pub fn distant(r: &mut Reader, path: &str) -> Result<SunSpec> {
     } else {
         radiance * (std::f64::consts::PI * half.sin().powi(2)) as f32
     };
+    if irradiance.max_element() > 0.0 && irradiance.max_element() < DIM_IRRADIANCE {
+        let hint = match normalize || angle <= 0.0 {
+            true => "",
+            false => {
+                " (normalize off: intensity is the radiance of its disk, times \
+                       pi sin^2(angle / 2); set inputs:normalize = 1 to give irradiance)"
+            }
+        };
+        r.warn(format!(
+            "{path}: irradiance {:.3e} W/m^2 lights nothing visibly (the default sun \
+             gives 2.5){hint}",
+            irradiance.max_element()
+        ));
+    }
     // The light's -Z axis, left for the sun to normalise (as a scene
     // file's direction is).
     let world = world_at(&r.stage, path, t)?;
