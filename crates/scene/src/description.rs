@@ -490,7 +490,6 @@ impl SceneDescription {
                 .map_err(|e| format!("volume {} ({}): {e}", i + 1, v.file.display()))?;
         }
         LightSpec::check_all(&self.lights)?;
-        crate::light_checks::check_shorthands(self)?;
         self.camera.check().map_err(|e| format!("[camera] {e}"))
     }
 }

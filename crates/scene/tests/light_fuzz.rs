@@ -262,10 +262,12 @@ fn run_case(path: &Path, tally: &mut Tally) {
         Err(e) => {
             let text = e.to_string();
             assert!(!text.is_empty());
-            // Errors found at load name the file; those at render (all
-            // samples dropped, light groups past the film) say what.
+            // Errors found at load name the file; those found when the
+            // settings resolve name the table and key (the shorthand
+            // tables) or what failed (every sample dropped).
+            let named = ["[sun]", "[environment]", "light group", "samples"];
             assert!(
-                text.contains(&name) || text.contains("light group") || text.contains("samples"),
+                text.contains(&name) || named.iter().any(|n| text.contains(n)),
                 "{name}: {text}"
             );
             tally.errors += 1;

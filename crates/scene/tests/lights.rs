@@ -282,33 +282,41 @@ fn light_values_that_overflow_f32_are_refused_by_key() {
             assert!(e.contains("light 1 (\"hot\")"), "{e}");
         }
     }
+    // The shorthand tables (and so their flags) are checked where the
+    // settings are resolved: their ranges by flag and key, then what a
+    // render can carry.
     for (body, says) in [
         (
             "[sun]\ndirection = [0, 0, 0]",
-            "[sun] direction [0, 0, 0] must be finite and not zero",
+            "--sun-dir ([sun] direction)",
         ),
         (
             "[sun]\nirradiance = [-1, 1, 1]",
-            "[sun] irradiance [-1, 1, 1] must be finite and at least 0",
+            "--sun-irradiance ([sun] irradiance)",
         ),
         (
             "[environment]\nrotation = nan",
-            "[environment] rotation NaN is not finite",
+            "--env-rotation ([environment] rotation)",
         ),
         (
             "[environment]\nradiance = [nan, 0, 0]",
-            "[environment] radiance [NaN, 0, 0]",
+            "--env-radiance ([environment] radiance)",
         ),
         (
             "[environment]\nradiance = [1e31, 0, 0]",
             "[environment] its mean radiance",
         ),
+        (
+            "[sun]\nirradiance = [1e29, 1e29, 1e29]\nangle = 0.01",
+            "[sun] its radiance (irradiance over the disc's solid angle)",
+        ),
     ] {
-        let e = error_of(&format!("{body}\n"));
-        assert!(
-            e.contains("bad.toml") && e.contains(says),
-            "{e} (expected {says:?})"
-        );
+        let e = scene(&format!("{body}\n"))
+            .settings()
+            .map(drop)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(says), "{e} (expected {says:?})");
     }
     // Within the limits, a normalised ball of any radius sends strength / 4.
     let lights = lights_of(
