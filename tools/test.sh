@@ -27,6 +27,9 @@ CIRRUS_OIDN=$(bash tools/oidn.sh target/venv/bin/python)
 export CIRRUS_OIDN
 cargo test --workspace --release
 bash tools/test_python.sh "$python"
+# The README's shell examples that make files, as written (numpy and
+# OpenEXR from the venv the Python tests made).
+target/venv/bin/python tools/readme_examples.py target/venv/bin/python
 bash tools/test_farm.sh target/venv/bin/python
 bash tools/browser_test.sh
 bash tools/test_blender.sh
