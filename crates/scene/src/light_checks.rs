@@ -6,6 +6,7 @@
 //! the sky maps named. Scene files and USD stages both come through here,
 //! so a light is refused by the same rule whichever wrote it.
 
+use cirrus_render::kernel::light::shown;
 use cirrus_render::{Environment, Light, Sun, MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE};
 use glam::Vec3;
 
@@ -286,17 +287,6 @@ impl LightSpec {
     }
 }
 
-/// `v` as a person writes it in a message: `[3.400e41, 0, 1]`.
-pub(crate) fn shown(v: Vec3) -> String {
-    let n = |x: f32| {
-        if x != 0.0 && x.is_finite() && (x.abs() >= 1e6 || x.abs() < 1e-4) {
-            format!("{x:.3e}")
-        } else {
-            format!("{x}")
-        }
-    };
-    format!("[{}, {}, {}]", n(v.x), n(v.y), n(v.z))
-}
 
 impl SunSpec {
     /// The `[sun]` table's (or its flags') values, as a distant light's

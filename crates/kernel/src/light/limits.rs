@@ -22,8 +22,8 @@ pub const MAX_LIGHT_VALUE: f32 = 1e30;
 /// light may have, in scene units.
 pub const MAX_LIGHT_EXTENT: f32 = 1e12;
 
-/// `v` as a person writes it in a message: `3.4e41`, `[1, 2, inf]`.
-fn shown(v: Vec3) -> String {
+/// `v` as a person writes it in a message: `[3.400e41, 0, inf]`.
+pub fn shown(v: Vec3) -> String {
     let n = |x: f32| {
         if x != 0.0 && x.is_finite() && (x.abs() >= 1e6 || x.abs() < 1e-4) {
             format!("{x:.3e}")

@@ -19,7 +19,7 @@ mod spherical_rect;
 pub use area::{AreaLight, AreaShape};
 pub use distant::Sun;
 pub use dome::Environment;
-pub use limits::{MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE};
+pub use limits::{shown, MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE};
 pub use sphere::{SphereLight, Spot};
 
 use glam::Vec3;
