@@ -287,7 +287,6 @@ impl LightSpec {
     }
 }
 
-
 impl SunSpec {
     /// The `[sun]` table's (or its flags') values, as a distant light's
     /// are checked: a finite, non-zero direction, an irradiance finite,
