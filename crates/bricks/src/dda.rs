@@ -129,16 +129,22 @@ impl CellRay {
         let far = Vec3A::select(self.upward, hi, lo);
         let exits = (far - self.origin) * self.inv_dir;
         let t0 = self.t;
+        // An exit at or behind `t0` means the point the walk located by
+        // rounded onto this cell's far face: the points the lookups see
+        // stay in this cell until that coordinate moves one ulp past the
+        // face, which takes `ulp / |d|` along the ray. Such an exit is
+        // moved on by that much. For an axis the ray crosses at any speed
+        // that is less than the nudge, and the step is the nudge as
+        // before; for an axis the ray creeps along (a component of 1e-7
+        // beside 1) it is long, and the walk goes on to the next face it
+        // does cross rather than creep by the nudge (which took ~1e5 steps
+        // per cell). `|far| x EPSILON` bounds the face's ulp.
+        let behind = exits.cmple(Vec3A::splat(t0));
+        let creep = far.abs() * f32::EPSILON * self.inv_dir.abs();
+        let exits = Vec3A::select(behind, exits + creep, exits);
         // Only an exit ahead of the walk bounds the step. An axis the ray
         // never crosses, from a point on one of its faces, gives
-        // 0 x inf = NaN. An axis the ray creeps along (a component of
-        // 1e-7 beside 1) gives an exit at or behind `t0` when its
-        // coordinate rounds onto the cell's far face: the points the
-        // lookups see stay in this cell until the rounding moves them, so
-        // that axis does not end the step, and the walk goes on to the
-        // next face it does cross rather than creep by the nudge (which
-        // took ~1e5 steps per cell). NaN compares false, so one mask
-        // drops both.
+        // 0 x inf = NaN, which compares false and is dropped with the rest.
         let ahead = exits.cmpgt(Vec3A::splat(t0));
         let exit = Vec3A::select(ahead, exits, Vec3A::INFINITY).min_element();
         // `exit` is never NaN, nor are the ray's ends, so plain compares
