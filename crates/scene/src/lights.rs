@@ -243,8 +243,9 @@ pub fn lights(desc: &SceneDescription) -> Result<Lights> {
         Ok(names) => names,
         Err(_) => DEFAULT_LIGHT_GROUPS.iter().map(|s| s.to_string()).collect(),
     };
+    // Domes to `sky`; every other kind to `sun`, as the kernel's own
+    // default groups put them.
     let kind_layer = |spec: &LightSpec| match spec.kind.as_str() {
-        "distant" => DEFAULT_LIGHT_GROUPS[0],
         "dome" => DEFAULT_LIGHT_GROUPS[1],
         _ => DEFAULT_LIGHT_GROUPS[0],
     };
