@@ -55,7 +55,7 @@ use super::per_light::{
     MIN_PROBABILITY,
 };
 pub(crate) use super::per_light::{PerLight, MAX_PICKED_LIGHTS};
-use crate::light::{AreaLight, Light, Lights, SphereLight};
+use crate::light::{Light, Lights, Whence};
 use crate::phase::Phase;
 use crate::sampling::UNIFORM_SPHERE_PDF;
 
@@ -113,19 +113,6 @@ pub(crate) enum LightChoice {
     Pick(PerLight),
 }
 
-/// Where a light lies, for its weight at a vertex.
-#[derive(Clone, Copy, Debug)]
-enum Aim {
-    /// Toward a distant light's centre.
-    Distant(Vec3),
-    /// From every direction.
-    Dome,
-    /// At a sphere light, its light falling off with distance.
-    Sphere(SphereLight),
-    /// At an area light, its light falling off with distance and angle.
-    Area(AreaLight),
-}
-
 /// The light choice of a render: what it weighs each light by, kept flat
 /// and built once from the lights (as pbrt-v4's light samplers keep
 /// theirs), and the pick at a vertex from it.
@@ -133,11 +120,11 @@ enum Aim {
 pub(crate) struct LightSampler {
     /// `All` or `One`, resolved for the lights.
     sampling: LightSampling,
-    /// Per light, the luminance of a distant light's irradiance or of a
-    /// dome's mean radiance.
+    /// The lights, up to [`MAX_PICKED_LIGHTS`] (past them the weighing is
+    /// `many`'s).
+    lights: Vec<Light>,
+    /// Per light, the luminance of its strength ([`Light::luminance`]).
     luminance: Vec<f32>,
-    /// Per light, where it lies: what its weight at a vertex depends on.
-    aim: Vec<Aim>,
     /// Per light, a distant light's disc's solid angle (0 for a delta
     /// light or a dome: no floor).
     disc: Vec<f32>,
@@ -155,24 +142,16 @@ pub(crate) struct LightSampler {
 impl LightSampler {
     /// The choice `sampling` (resolved here) makes among `lights`.
     pub fn new(lights: &Lights, sampling: LightSampling) -> Self {
-        let (aim, disc) = lights
-            .iter()
-            .map(|light| match light {
-                Light::Distant(sun) => (Aim::Distant(-sun.direction()), sun.solid_angle()),
-                Light::Dome(_) => (Aim::Dome, 0.0),
-                Light::Sphere(s) => (Aim::Sphere(*s), 0.0),
-                Light::Area(a) => (Aim::Area(*a), 0.0),
-            })
-            .unzip();
+        let disc = lights.iter().map(Light::disc_solid_angle).collect();
         let luminance: Vec<f32> = lights.iter().map(Light::luminance).collect();
         let mut isotropic = PerLight::zeros(lights.len().min(MAX_PICKED_LIGHTS));
         for ((w, l), light) in isotropic.iter_mut().zip(&luminance).zip(lights.iter()) {
-            *w = match light {
-                Light::Distant(_) => l * UNIFORM_SPHERE_PDF,
-                Light::Dome(_) => *l,
-                // Its weight depends on where the vertex is, which the
-                // estimate does not know.
-                Light::Sphere(_) | Light::Area(_) => 0.0,
+            // A light in the scene weighs by where the vertex is, which
+            // the estimate does not know.
+            *w = match light.whence(Vec3::ZERO) {
+                _ if !light.is_at_infinity() => 0.0,
+                Whence::Everywhere => *l,
+                Whence::Toward { .. } => l * UNIFORM_SPHERE_PDF,
             };
         }
         let sampling = sampling.resolve(lights);
@@ -186,8 +165,8 @@ impl LightSampler {
         Self {
             sampling,
             many,
+            lights: lights.iter().take(MAX_PICKED_LIGHTS).cloned().collect(),
             luminance,
-            aim,
             disc,
             isotropic,
             lanes: lanes_of(lights.len()),
@@ -223,7 +202,7 @@ impl LightSampler {
     /// The light a weighed pick at `at` samples with `u`, and its
     /// probability.
     #[inline]
-    pub fn pick_weighed(&self, at: Vec3, total: f32, u: f32) -> (usize, f32) {
+    pub fn pick_weighed(&self, at: Vec3, total: f32, u: f32) -> Option<(usize, f32)> {
         self.many
             .as_ref()
             .expect("a weighed pick has its weights")
@@ -237,21 +216,15 @@ impl LightSampler {
     /// probability its disc needs ([`disc_floor`]; 0 for other lights).
     #[inline(always)]
     fn weigh(&self, i: usize, phase: &Phase, p: Vec3, dir_in: Vec3) -> (f32, f32) {
-        match &self.aim[i] {
-            Aim::Distant(to_light) => {
-                let f = phase.eval(dir_in, *to_light);
+        let light = &self.lights[i];
+        let open = light.luminance_at(p, self.luminance[i]);
+        match light.whence(p) {
+            Whence::Everywhere => (open, 0.0),
+            Whence::Toward { dir, .. } => {
+                let f = phase.eval(dir_in, dir);
                 let disc = self.disc[i];
                 let floor = if disc > 0.0 { disc_floor(f, disc) } else { 0.0 };
-                (self.luminance[i] * f, floor)
-            }
-            Aim::Dome => (self.luminance[i], 0.0),
-            Aim::Sphere(s) => {
-                let f = phase.eval(dir_in, (s.position() - p).normalize_or_zero());
-                (s.luminance_at(p, self.luminance[i]) * f, 0.0)
-            }
-            Aim::Area(a) => {
-                let f = phase.eval(dir_in, (a.centre() - p).normalize_or_zero());
-                (a.luminance_at(p, self.luminance[i]) * f, 0.0)
+                (open * f, floor)
             }
         }
     }

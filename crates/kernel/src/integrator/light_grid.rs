@@ -8,7 +8,7 @@ use super::march::{marched_transmittance, ShadowEnd, MIN_STEP_VOXELS};
 
 use super::light_choice::PerLight;
 use crate::counters::Counters;
-use crate::light::{Light, LightKind, Lights};
+use crate::light::{Lights, Whence};
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::sampling::{from_local, Rng};
@@ -83,8 +83,10 @@ pub struct LightGrid {
     /// The highest stencil corner along each axis: `points - 2`, at least 0.
     max_base: Vec3,
     bricks: [usize; 3],
-    /// The kinds of the lights the grid was built for, in order.
-    kinds: Vec<LightKind>,
+    /// Per light the grid was built for, in order, whether its light
+    /// comes from every direction (a dome: four slots, its transmittance's
+    /// mean and first moment) rather than along one (one slot).
+    everywhere: Vec<bool>,
     /// Slots per lattice point: one per light.
     width: usize,
     /// Per brick, its [`STORED`]^3 entries (x fastest) of `width` slots
@@ -114,15 +116,18 @@ impl LightGrid {
         let extent = bounds.size().max(Vec3::ZERO);
         let points = [0, 1, 2].map(|a| (extent[a] / cell).ceil() as usize + 1);
         let bricks = points.map(|n| n.div_ceil(BRICK));
-        let kinds: Vec<LightKind> = lights.iter().map(Light::kind).collect();
-        let width = kinds.len();
+        let everywhere: Vec<bool> = lights
+            .iter()
+            .map(|l| l.whence(Vec3::ZERO) == Whence::Everywhere)
+            .collect();
+        let width = everywhere.len();
         let mut grid = Self {
             lo,
             cell,
             points,
             max_base: Vec3::from_array(points.map(|n| n.saturating_sub(2) as f32)),
             bricks,
-            kinds,
+            everywhere,
             width,
             brick_data: Vec::new(),
         };
@@ -299,9 +304,9 @@ impl LightGrid {
             marched_transmittance::<M, f32>(medium, p, dir, distance, step, end, rng, c)
         };
         for (slot, light) in entry.iter_mut().zip(lights.iter()) {
-            match light {
-                Light::Distant(sun) => slot.x = shadow(-sun.direction(), f32::INFINITY, rng, c),
-                Light::Dome(_) => {
+            match light.whence(p) {
+                Whence::Toward { dir, distance } => slot.x = shadow(dir, distance, rng, c),
+                Whence::Everywhere => {
                     // Directions stratified in cos(theta), random in phi.
                     let (mut a, mut b) = (0.0, Vec3::ZERO);
                     for s in 0..env_dirs {
@@ -316,18 +321,6 @@ impl LightGrid {
                     let inv = 1.0 / env_dirs as f32;
                     let b = b * inv;
                     *slot = Vec4::new(a * inv, b.x, b.y, b.z);
-                }
-                Light::Area(light) => {
-                    // Toward the centre.
-                    let to = light.centre() - p;
-                    let d = to.length();
-                    slot.x = shadow(to / d, d, rng, c);
-                }
-                Light::Sphere(light) => {
-                    // Toward the centre, to the ball's surface.
-                    let to = light.position() - p;
-                    let d = to.length();
-                    slot.x = shadow(to / d, (d - light.radius()).max(0.0), rng, c);
                 }
             }
         }
@@ -396,25 +389,27 @@ impl LightGrid {
     /// with the phase function's mean cosine (see [`LightGrid`]).
     /// At most [`MAX_PICKED_LIGHTS`](super::light_choice::MAX_PICKED_LIGHTS) lights: the light choice's.
     pub(crate) fn seen(&self, phase: &Phase, p: Vec3, dir: Vec3) -> PerLight {
-        let mut seen = PerLight::zeros(self.kinds.len());
+        let mut seen = PerLight::zeros(self.everywhere.len());
         let mean_cosine = phase.mean_cosine();
         let mut i = 0;
         self.lookup_each(p, |slot| {
-            if let (Some(seen), Some(&kind)) = (seen.get_mut(i), self.kinds.get(i)) {
-                *seen = Self::seen_in(kind, slot, mean_cosine, dir);
+            if let (Some(seen), Some(&everywhere)) = (seen.get_mut(i), self.everywhere.get(i)) {
+                *seen = Self::seen_in(everywhere, slot, mean_cosine, dir);
             }
             i += 1;
         });
         seen
     }
 
-    /// The fraction of a light of `kind` seen through a slot by a phase
-    /// function of mean cosine `mean_cosine`.
+    /// The fraction of a light seen through a slot by a phase function of
+    /// mean cosine `mean_cosine`: one transmittance for a light along one
+    /// direction, two bands for one from `everywhere`.
     #[inline]
-    fn seen_in(kind: LightKind, slot: Vec4, mean_cosine: f32, dir: Vec3) -> f32 {
-        match kind {
-            LightKind::Distant | LightKind::Sphere | LightKind::Area => slot.x,
-            LightKind::Dome => (slot.x + 3.0 * mean_cosine * slot.yzw().dot(dir)).max(0.0),
+    fn seen_in(everywhere: bool, slot: Vec4, mean_cosine: f32, dir: Vec3) -> f32 {
+        if everywhere {
+            (slot.x + 3.0 * mean_cosine * slot.yzw().dot(dir)).max(0.0)
+        } else {
+            slot.x
         }
     }
 
@@ -433,28 +428,9 @@ impl LightGrid {
         let mut i = 0;
         self.lookup_each(p, |slot| {
             let light = lights.get(i);
-            let seen = Self::seen_in(light.kind(), slot, phase.mean_cosine(), dir);
-            let l = match light {
-                Light::Distant(sun) => {
-                    let f = phase.eval(dir, -sun.direction());
-                    sun.irradiance() * (f * seen)
-                }
-                Light::Dome(env) => env.mean_radiance() * seen,
-                Light::Sphere(light) => {
-                    // The ball taken for a point at its centre.
-                    let to = light.position() - p;
-                    let d2 = to.length_squared().max(light.radius() * light.radius());
-                    let w = to.normalize_or_zero();
-                    let f = phase.eval(dir, w) * light.falloff(-w);
-                    light.intensity() * (f * seen / d2)
-                }
-                Light::Area(light) => {
-                    // The shape taken for a point at its centre.
-                    let w = (light.centre() - p).normalize_or_zero();
-                    let e = light.luminance_at(p, 1.0);
-                    light.radiance() * (phase.eval(dir, w) * e * seen)
-                }
-            };
+            let everywhere = self.everywhere.get(i).copied().unwrap_or(false);
+            let seen = Self::seen_in(everywhere, slot, phase.mean_cosine(), dir);
+            let l = light.in_scattered(phase, p, dir, seen);
             s.add(lights.group(i), l);
             i += 1;
         });

@@ -11,6 +11,7 @@ mod distance_sampling;
 mod light_choice;
 mod light_grid;
 mod light_sampling;
+mod light_tree;
 mod many_lights;
 mod march;
 mod path;
@@ -37,7 +38,7 @@ use glam::Vec3;
 
 use crate::counters::Counters;
 use crate::light::GroupRadiance;
-use crate::light::{LightKind, Lights};
+use crate::light::Lights;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Rng, SampleStream};
 use light_choice::{LightChoice, LightSampler};
@@ -126,8 +127,10 @@ pub(crate) fn escaped_radiance(
     c: &mut Counters,
 ) -> LightParts {
     let mut l = LightParts::default();
-    for (i, light) in lights.iter().enumerate() {
-        c.dome_samples += u64::from(light.kind() == LightKind::Dome);
+    for &i in lights.at_infinity() {
+        let i = i as usize;
+        let light = lights.get(i);
+        light.count_sample(c);
         if let Some((radiance, pdf)) = light.escaped(dir) {
             let weight = phase_pdf.map_or(1.0, |(p, choice, sampler)| {
                 power_heuristic(p, sampler.probability(choice, i) * pdf)

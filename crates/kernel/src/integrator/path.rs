@@ -9,12 +9,13 @@ use super::distance_sampling::DistanceSampling;
 use super::light_choice::{LightChoice, LightSampler, PerLight};
 use super::light_grid::LightGrid;
 use super::light_sampling::LightSampling;
+use super::path_equiangular::PointPick;
 use super::path_state::{Arrival, At, Escape, Path, Vertex};
 use super::sunward_mode::Sunward;
 use super::{escaped_radiance, AovSample, CameraSampler, Sample};
 use crate::counters::Counters;
 use crate::light::GroupRadiance;
-use crate::light::{Light, Lights, SphereLight, Sun};
+use crate::light::{Light, Lights, Sun};
 use crate::medium::{Interaction, Media};
 use crate::phase::Phase;
 use crate::ray::Ray;
@@ -90,11 +91,14 @@ pub struct PathTracer<'a, M> {
     pub(super) estimator: TransmittanceEstimator,
     pub(super) max_depth: Option<u32>,
     chromatic: bool,
-    /// Whether any light is a surface rays can meet, a ball or an area
-    /// light (`path_flight.rs`).
-    pub(super) has_surfaces: bool,
-    /// The sphere, point and spot lights, with their indices.
-    pub(super) spheres: Vec<(usize, SphereLight)>,
+    /// The indices of the lights rays can meet, balls and area lights
+    /// (`path_flight.rs`).
+    pub(super) surfaces: Vec<usize>,
+    /// The indices of the point-like lights (balls, points and spots),
+    /// which equi-angular sampling aims at.
+    pub(super) points: Vec<usize>,
+    /// The pick of one of them for a segment's equi-angular sample.
+    pub(super) point_pick: PointPick,
     /// Whether segments take an equi-angular sample toward them
     /// (`path_equiangular.rs`).
     pub(super) equiangular: bool,
@@ -121,17 +125,14 @@ impl<'a, M: Media> PathTracer<'a, M> {
         max_depth: Option<u32>,
     ) -> Self {
         let lights = lights.pruned();
-        let has_surfaces = lights.any_surface();
-        let spheres: Vec<(usize, SphereLight)> = lights
-            .iter()
-            .enumerate()
-            .filter_map(|(i, l)| match l {
-                Light::Sphere(s) => Some((i, *s)),
-                _ => None,
-            })
-            .collect();
+        let of = |keep: fn(&Light) -> bool| -> Vec<usize> {
+            (0..lights.len()).filter(|&i| keep(lights.get(i))).collect()
+        };
+        let surfaces = of(Light::is_surface);
+        let points = of(|l| l.point_centre().is_some());
+        let point_pick = PointPick::new(&lights, &points);
         let equiangular =
-            !spheres.is_empty() && DistanceSampling::default().samples_equiangular(medium);
+            !points.is_empty() && DistanceSampling::default().samples_equiangular(medium);
         // The first of the brightest, where several are alike.
         let sunward_light = lights
             .distant()
@@ -140,8 +141,9 @@ impl<'a, M: Media> PathTracer<'a, M> {
             .map(|(i, _)| i);
         Self {
             medium,
-            has_surfaces,
-            spheres,
+            surfaces,
+            points,
+            point_pick,
             equiangular,
             sunward_light,
             sampler: LightSampler::new(&lights, LightSampling::default()),
@@ -215,7 +217,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     /// sampling only where there are sphere lights).
     pub fn with_distance_sampling(self, sampling: DistanceSampling) -> Self {
         Self {
-            equiangular: !self.spheres.is_empty() && sampling.samples_equiangular(self.medium),
+            equiangular: !self.points.is_empty() && sampling.samples_equiangular(self.medium),
             ..self
         }
     }
@@ -230,10 +232,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
     #[inline]
     pub(super) fn sunward_sun(&self) -> Option<(usize, &Sun)> {
         let i = self.sunward_light?;
-        match self.lights.get(i) {
-            Light::Distant(sun) => Some((i, sun)),
-            _ => None,
-        }
+        Some((i, self.lights.get(i).as_distant()?))
     }
 }
 

@@ -25,18 +25,22 @@
 //!
 //! One light per segment takes the equi-angular sample, picked in
 //! proportion to its unoccluded single scattering along the span, `I (theta_b
-//! - theta_a) / h`.
+//! - theta_a) / h` ([`PointPick`]): among a few lights, each weighed so;
+//! among many, by a light tree weighing its nodes by the same integral
+//! along the segment (Cycles' light tree for volume segments).
 
 use glam::Vec3;
 
 use super::path::PathTracer;
 use super::path_state::{Arrival, Path, Vertex};
 use crate::counters::Counters;
-use crate::light::{Light, SphereLight};
+use super::light_tree::LightTree;
+use super::per_light::MAX_PICKED_LIGHTS;
+use crate::light::{LightBounds, Lights};
 use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, SampleStream};
-use crate::spectrum::{luminance, Spectrum};
+use crate::spectrum::Spectrum;
 use crate::tracking::transmittance;
 
 /// The light sample rank the equi-angular point's next-event estimate
@@ -119,6 +123,82 @@ fn span<M: Media>(medium: &M, ray: &Ray) -> Option<(f32, f32)> {
     (t1 > t0 && t1.is_finite()).then_some((t0, t1))
 }
 
+/// How a segment picks the point-like light its equi-angular sample aims
+/// at.
+#[derive(Clone, Debug)]
+pub(crate) enum PointPick {
+    /// Among a few: each light's centre and intensity luminance, weighed
+    /// by its reach along the segment.
+    Few(Vec<(usize, Vec3, f32)>),
+    /// Among many: a light tree over them.
+    Many(LightTree),
+}
+
+impl PointPick {
+    /// The pick among the lights of `lights` at the indices `points`.
+    pub fn new(lights: &Lights, points: &[usize]) -> Self {
+        if points.len() > MAX_PICKED_LIGHTS {
+            if let Some(tree) = LightTree::new(lights, points) {
+                return Self::Many(tree);
+            }
+        }
+        Self::Few(
+            points
+                .iter()
+                .filter_map(|&i| {
+                    let light = lights.get(i);
+                    Some((i, light.point_centre()?, light.luminance()))
+                })
+                .collect(),
+        )
+    }
+
+    /// The light `u` picks for `ray`'s span `[t0, t1]`: its index, its
+    /// sampler and its probability.
+    #[inline]
+    fn pick(
+        &self,
+        lights: &Lights,
+        ray: &Ray,
+        t0: f32,
+        t1: f32,
+        u: f32,
+    ) -> Option<(usize, EquiAngular, f32)> {
+        match self {
+            Self::Few(points) => {
+                // Two passes: the sum, then the pick, recomputing each
+                // light's sampler.
+                let reach = |&(i, c, l): &(usize, Vec3, f32)| {
+                    let ea = EquiAngular::new(ray, c, t0, t1)?;
+                    let w = l * ea.reach();
+                    (w > 0.0 && w.is_finite()).then_some((i, ea, w))
+                };
+                let total: f32 = points.iter().filter_map(reach).map(|r| r.2).sum();
+                if !(total > 0.0 && total.is_finite()) {
+                    return None;
+                }
+                let u = u * total;
+                let mut end = 0.0;
+                let mut chosen = None;
+                for r in points.iter().filter_map(reach) {
+                    end += r.2;
+                    chosen = Some(r);
+                    if u < end {
+                        break;
+                    }
+                }
+                chosen.map(|(i, ea, w)| (i, ea, w / total))
+            }
+            Self::Many(tree) => {
+                let reach = |b: &LightBounds| b.segment_importance(ray.origin, ray.dir, t0, t1);
+                let (i, q) = tree.pick(reach, u)?;
+                let ea = EquiAngular::new(ray, lights.get(i).point_centre()?, t0, t1)?;
+                Some((i, ea, q))
+            }
+        }
+    }
+}
+
 impl<M: Media> PathTracer<'_, M> {
     /// Whether a segment flown at `path.depth` takes an equi-angular sample:
     /// where a collision on it would estimate the lights (not past the
@@ -132,7 +212,7 @@ impl<M: Media> PathTracer<'_, M> {
     /// vertex `v` against the equi-angular sample of the segment that
     /// reached it: one minus the equi-angular strategy's weight there.
     #[inline]
-    pub(super) fn collision_weight(&self, v: &Vertex, light: &SphereLight) -> f32 {
+    pub(super) fn collision_weight(&self, v: &Vertex, centre: Vec3) -> f32 {
         if !self.equiangular {
             return 1.0;
         }
@@ -140,7 +220,7 @@ impl<M: Media> PathTracer<'_, M> {
         let Some((t0, t1)) = span(self.medium, ray) else {
             return 1.0;
         };
-        let Some(ea) = EquiAngular::new(ray, light.position(), t0, t1) else {
+        let Some(ea) = EquiAngular::new(ray, centre, t0, t1) else {
             return 1.0;
         };
         let t = (v.p - ray.origin).dot(ray.dir);
@@ -160,38 +240,10 @@ impl<M: Media> PathTracer<'_, M> {
         let Some((t0, t1)) = span(self.medium, &ray) else {
             return;
         };
-        // One sphere light picked in proportion to its reach (two passes:
-        // the sum, then the pick, recomputing each light's sampler).
-        let reach = |s: &SphereLight| {
-            let ea = EquiAngular::new(&ray, s.position(), t0, t1)?;
-            let w = luminance(s.intensity()) * ea.reach();
-            (w > 0.0 && w.is_finite()).then_some((ea, w))
-        };
-        let total: f32 = self
-            .spheres
-            .iter()
-            .filter_map(|(_, s)| reach(s))
-            .map(|r| r.1)
-            .sum();
-        if !(total > 0.0 && total.is_finite()) {
-            return;
-        }
-        let u = draws.rng().uniform() * total;
-        let mut end = 0.0;
-        let mut chosen = None;
-        for (i, s) in &self.spheres {
-            if let Some((ea, w)) = reach(s) {
-                end += w;
-                chosen = Some((*i, ea, w));
-                if u < end {
-                    break;
-                }
-            }
-        }
-        let Some((light, ea, w)) = chosen else {
+        let u = draws.rng().uniform();
+        let Some((light, ea, q)) = self.point_pick.pick(&self.lights, &ray, t0, t1, u) else {
             return;
         };
-        let q = w / total;
         let (t, pdf) = ea.sample(draws.rng().uniform());
         if !(t > t0 && t < t1 && pdf > 0.0) {
             return;
@@ -217,10 +269,14 @@ impl<M: Media> PathTracer<'_, M> {
             choice: super::light_choice::LightChoice::All,
             arrival: Arrival::default(),
         };
-        let Light::Sphere(sphere) = self.lights.get(light) else {
-            return;
-        };
-        let n = self.sphere_sample::<S>(&v, sphere, 1.0, EQUIANGULAR_LIGHT_SAMPLE, draws, c);
+        let n = self.sample_light::<S>(
+            &v,
+            self.lights.get(light),
+            1.0,
+            EQUIANGULAR_LIGHT_SAMPLE,
+            draws,
+            c,
+        );
         let scale = weight(pdf, t1 - t0) / (q * pdf);
         let e = path.beta * tr.rgb() * sigma_t.rgb() * it.albedo * it.weight * n * scale;
         path.add_to_group(e, self.lights.group(light), self.light_groups);

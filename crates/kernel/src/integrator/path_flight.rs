@@ -21,7 +21,7 @@ use glam::Vec3;
 use super::path::PathTracer;
 use super::path_state::{Escape, Path};
 use crate::counters::Counters;
-use crate::light::Light;
+use crate::light::LightHit;
 use crate::medium::Media;
 use crate::ray::Ray;
 use crate::sampling::{power_heuristic, Draw, SampleStream};
@@ -50,7 +50,7 @@ impl<M: Media> PathTracer<'_, M> {
         c: &mut Counters,
     ) -> FreeFlight {
         let ray = path.ray;
-        if !self.has_surfaces {
+        if self.surfaces.is_empty() {
             return draws.leading(Draw::FreeFlight, vertex, |rng| {
                 sample_free_flight::<S, M>(self.medium, &ray, ray.t_max, &mut path.beta, rng, c)
             });
@@ -96,17 +96,13 @@ impl<M: Media> PathTracer<'_, M> {
         after: Option<(f32, usize)>,
     ) -> Option<SurfaceHit> {
         let mut best: Option<SurfaceHit> = None;
-        for (i, light) in self.lights.iter().enumerate() {
-            let hit = match light {
-                Light::Sphere(ball) if !camera || ball.camera_visible() => {
-                    ball.hit(ray.origin, ray.dir, ray.t_max)
-                }
-                Light::Area(area) if !camera || area.camera_visible() => {
-                    area.hit(ray.origin, ray.dir, ray.t_max)
-                }
-                _ => None,
-            };
-            let Some((t, radiance, pdf)) = hit else {
+        for &i in &self.surfaces {
+            let light = self.lights.get(i);
+            if camera && !light.camera_visible() {
+                continue;
+            }
+            let Some(LightHit { t, radiance, pdf }) = light.hit(ray.origin, ray.dir, ray.t_max)
+            else {
                 continue;
             };
             let later = after.is_none_or(|(t0, i0)| (t, i) > (t0, i0));

@@ -10,7 +10,7 @@ use super::path::PathTracer;
 use super::path_state::Vertex;
 use super::LightParts;
 use crate::counters::Counters;
-use crate::light::{Environment, Light, LightSample, SphereLight};
+use crate::light::{Light, LightSample};
 use crate::medium::Media;
 use crate::sampling::{power_heuristic, Draw, SampleStream};
 use crate::spectrum::Spectrum;
@@ -38,9 +38,12 @@ impl<M: Media> PathTracer<'_, M> {
             }
             LightChoice::Weighed { at, total } => {
                 let u = draws.rng().uniform();
-                let (i, p) = self.sampler.pick_weighed(*at, *total, u);
-                let e = self.light_sample::<S>(v, i, p, 0, draws, c);
-                l.add(self.lights.group(i), e);
+                // None where the lights in the scene send nothing toward
+                // the vertex (the lights at infinity were not picked).
+                if let Some((i, p)) = self.sampler.pick_weighed(*at, *total, u) {
+                    let e = self.light_sample::<S>(v, i, p, 0, draws, c);
+                    l.add(self.lights.group(i), e);
+                }
             }
             LightChoice::Pick(p) => {
                 // Where the probabilities sum below one the vertex samples
@@ -56,7 +59,11 @@ impl<M: Media> PathTracer<'_, M> {
     }
 
     /// The `k`-th light sample at `v`: light `i`, which the vertex samples
-    /// with probability `pick`.
+    /// with probability `pick`, weighed against the other strategies that
+    /// gather its light there: the equi-angular sample of the segment that
+    /// reached the vertex (toward a point-like light, `path_equiangular.rs`)
+    /// and sunward scattering at the previous vertex (toward the sunward
+    /// light).
     fn light_sample<S: Spectrum>(
         &self,
         v: &Vertex,
@@ -67,87 +74,59 @@ impl<M: Media> PathTracer<'_, M> {
         c: &mut Counters,
     ) -> Vec3 {
         let light = self.lights.get(i);
-        if let Light::Sphere(sphere) = light {
-            // Shared with the equi-angular sample of the segment that
-            // reached the vertex (`path_equiangular.rs`).
-            let w = self.collision_weight(v, sphere);
-            return w * self.sphere_sample::<S>(v, sphere, pick, k, draws, c);
-        }
-        let (u1, u2) = draws.get_2d(Draw::LightDirection(k), v.index);
-        let shadow = Draw::LightShadow(k);
-        match light {
-            Light::Distant(sun) => {
-                let s = sun.sample(u1, u2);
-                c.nee_rays_distant += 1;
-                // The sunward light's estimate shares its light with
-                // sunward scattering at the previous vertex.
-                let weight = if self.sunward_light == Some(i) {
-                    v.arrival.sun_weight(pick)
-                } else {
-                    1.0
-                };
-                weight * self.light_term::<S>(v, s, pick, shadow, draws, c)
-            }
-            Light::Dome(env) => {
-                let s = self.sky_sample(v, env, u1, u2);
-                c.dome_samples += 1;
-                // A zero-density sample (a pole) is dropped without a shadow ray.
-                c.nee_rays_dome += u64::from(s.pdf.is_some_and(|p| p > 0.0));
-                self.light_term::<S>(v, s, pick, shadow, draws, c)
-            }
-            Light::Area(area) => {
-                let s = area.sample(v.p, u1, u2);
-                // From behind the light: nothing, no shadow ray.
-                if s.radiance == Vec3::ZERO {
-                    return Vec3::ZERO;
-                }
-                c.nee_rays_area += 1;
-                self.light_term::<S>(v, s, pick, shadow, draws, c)
-            }
-            Light::Sphere(_) => unreachable!("sampled above"),
-        }
+        let weight = match light.point_centre() {
+            Some(centre) => self.collision_weight(v, centre),
+            None if self.sunward_light == Some(i) => v.arrival.sun_weight(pick),
+            None => 1.0,
+        };
+        weight * self.sample_light::<S>(v, light, pick, k, draws, c)
     }
 
-    /// The `k`-th light sample at `v` of sphere light `light`, which the
-    /// vertex samples with probability `pick`.
-    pub(super) fn sphere_sample<S: Spectrum>(
+    /// The `k`-th light sample at `v` of `light`, which the vertex samples
+    /// with probability `pick`.
+    pub(super) fn sample_light<S: Spectrum>(
         &self,
         v: &Vertex,
-        light: &SphereLight,
+        light: &Light,
         pick: f32,
         k: u32,
         draws: &mut SampleStream,
         c: &mut Counters,
     ) -> Vec3 {
         let (u1, u2) = draws.get_2d(Draw::LightDirection(k), v.index);
-        let s = light.sample(v.p, u1, u2);
-        // Outside a spot's cone, or inside the ball: no light, no shadow
-        // ray.
-        if s.radiance == Vec3::ZERO {
+        let s = self.sample_toward(v, light, u1, u2);
+        light.count_sample(c);
+        // Outside a spot's cone, behind an area light, or a zero-density
+        // direction (a map's pole): no light, no shadow ray.
+        if s.radiance == Vec3::ZERO || s.pdf.is_some_and(|p| p <= 0.0) {
             return Vec3::ZERO;
         }
-        c.nee_rays_sphere += 1;
+        light.count_shadow_ray(c);
         self.light_term::<S>(v, s, pick, Draw::LightShadow(k), draws, c)
     }
 
-    /// The sky's direction at `v`: drawn from the sky itself, except for a
-    /// constant sky at a vertex without MIS (the last one a path may
-    /// scatter at), where it is drawn from the phase function, the
-    /// importance sampling of `f * L` for any constant `L`. There nothing
-    /// weighs the draw against another strategy, and a sky sampled
-    /// uniformly against a narrow phase lobe (Mie scattering by cloud
-    /// droplets) is a heavy-tailed estimate that a light pick's small
-    /// probability then multiplies into fireflies.
-    fn sky_sample(&self, v: &Vertex, env: &Environment, u1: f32, u2: f32) -> LightSample {
-        if v.mis || env.map.is_some() {
-            return env.sample(u1, u2);
-        }
-        let (to_light, pdf) = v.phase.sample(v.ray_in.dir, u1, u2);
-        LightSample {
-            to_light,
-            radiance: env.radiance,
-            pdf: Some(pdf),
-            distance: f32::INFINITY,
+    /// A direction toward `light` at `v`: drawn from the light itself,
+    /// except for a light the same from every direction (a constant sky)
+    /// at a vertex without MIS (the last one a path may scatter at), where
+    /// it is drawn from the phase function, the importance sampling of `f
+    /// * L` for any constant `L`. There nothing weighs the draw against
+    /// another strategy, and a sky sampled uniformly against a narrow
+    /// phase lobe (Mie scattering by cloud droplets) is a heavy-tailed
+    /// estimate that a light pick's small probability then multiplies into
+    /// fireflies.
+    #[inline]
+    fn sample_toward(&self, v: &Vertex, light: &Light, u1: f32, u2: f32) -> LightSample {
+        match light.uniform_radiance() {
+            Some(radiance) if !v.mis => {
+                let (to_light, pdf) = v.phase.sample(v.ray_in.dir, u1, u2);
+                LightSample {
+                    to_light,
+                    radiance,
+                    pdf: Some(pdf),
+                    distance: f32::INFINITY,
+                }
+            }
+            _ => light.sample_toward(v.p, u1, u2),
         }
     }
 

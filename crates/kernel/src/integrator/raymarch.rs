@@ -6,7 +6,7 @@ use glam::Vec3;
 use super::march::{march_camera_ray, marched_transmittance, ShadowEnd};
 use super::{CameraSampler, LightParts, Sample};
 use crate::counters::Counters;
-use crate::light::{Light, Lights};
+use crate::light::Lights;
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
@@ -70,26 +70,18 @@ impl<'a, M: Media> RayMarcher<'a, M> {
             // light's shape sampled uniformly (radiance / pdf is what they
             // deliver); a dome along a phase-sampled direction.
             let (u1, u2) = (rng.uniform(), rng.uniform());
-            let (w, f, radiance, t_max) = match light {
-                Light::Distant(sun) => {
-                    let ls = sun.sample(u1, u2);
-                    let f = phase.eval(dir, ls.to_light);
-                    (ls.to_light, f, sun.irradiance(), f32::INFINITY)
-                }
-                Light::Dome(env) => {
-                    c.dome_samples += 1;
-                    let w = phase.sample(dir, u1, u2).0;
-                    (w, 1.0, env.eval(w).0, f32::INFINITY)
-                }
-                Light::Sphere(_) | Light::Area(_) => {
-                    let Some(ls) = light.sample_from(p, u1, u2) else {
-                        continue;
-                    };
+            let (w, f, radiance, t_max) = match light.march_sample(p, u1, u2) {
+                Some(ls) => {
                     if ls.radiance == Vec3::ZERO {
                         continue;
                     }
                     let f = phase.eval(dir, ls.to_light) / ls.pdf.unwrap_or(1.0);
                     (ls.to_light, f, ls.radiance, ls.distance)
+                }
+                None => {
+                    light.count_sample(c);
+                    let w = phase.sample(dir, u1, u2).0;
+                    (w, 1.0, light.escaped(w).map_or(Vec3::ZERO, |e| e.0), f32::INFINITY)
                 }
             };
             let tr: E = marched_transmittance(

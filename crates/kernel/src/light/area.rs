@@ -114,6 +114,15 @@ impl AreaLight {
         self.shape
     }
 
+    /// Half the sides of a box about its centre holding the shape.
+    pub fn half_extent(&self) -> Vec3 {
+        match self.shape {
+            // Its radius turns about the axis.
+            AreaShape::Cylinder => self.half_u.abs() + Vec3::splat(self.half_v.length()),
+            AreaShape::Rect | AreaShape::Disk => self.half_u.abs() + self.half_v.abs(),
+        }
+    }
+
     /// The same light, seen by camera rays where `visible`.
     pub fn seen_by_camera(self, visible: bool) -> Self {
         Self {

@@ -10,13 +10,17 @@
 //! are or of which kind, only for the list and each light's group.
 
 mod area;
+mod bounds;
 mod distant;
 mod dome;
+mod interface;
 mod limits;
 mod sphere;
 mod spherical_rect;
 
 pub use area::{AreaLight, AreaShape};
+pub use bounds::LightBounds;
+pub use interface::{LightHit, Whence};
 pub use distant::Sun;
 pub use dome::Environment;
 pub use limits::{shown, MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE};
@@ -118,17 +122,6 @@ impl Light {
         }
     }
 
-    /// A sample from `p` of a light in the scene (a sphere or area
-    /// light), `None` for lights at infinity (sampled by direction alone).
-    #[inline]
-    pub fn sample_from(&self, p: Vec3, u1: f32, u2: f32) -> Option<LightSample> {
-        match self {
-            Self::Sphere(s) => Some(s.sample(p, u1, u2)),
-            Self::Area(a) => Some(a.sample(p, u1, u2)),
-            Self::Distant(_) | Self::Dome(_) => None,
-        }
-    }
-
     /// Radiance reaching a ray that escapes along `dir` and the density
     /// with which [`sample`](Self::sample) would have drawn `dir`; `None`
     /// where the light is not seen that way (outside a disc, or a delta
@@ -178,6 +171,16 @@ pub struct Lights {
     list: Vec<Light>,
     groups: Vec<u8>,
     emission_group: u8,
+    /// [`Self::at_infinity`], kept so that an escaping ray does not walk
+    /// every light of a scene of thousands.
+    at_infinity: Vec<u32>,
+}
+
+/// The indices of the lights of `list` at infinity.
+fn at_infinity(list: &[Light]) -> Vec<u32> {
+    (0..list.len() as u32)
+        .filter(|&i| list[i as usize].is_at_infinity())
+        .collect()
 }
 
 impl Default for Lights {
@@ -200,6 +203,7 @@ impl Lights {
         let list: Vec<Light> = lights.into_iter().collect();
         let groups = list.iter().map(|l| default_group(l.kind())).collect();
         Self {
+            at_infinity: at_infinity(&list),
             list,
             groups,
             emission_group: DEFAULT_GROUP_EMISSION,
@@ -211,8 +215,9 @@ impl Lights {
     /// [`MAX_LIGHT_GROUPS`]) it is tagged with, and
     /// the media's emission tagged with `emission_group`.
     pub fn grouped(lights: impl IntoIterator<Item = (Light, u8)>, emission_group: u8) -> Self {
-        let (list, groups) = lights.into_iter().unzip();
+        let (list, groups): (Vec<Light>, _) = lights.into_iter().unzip();
         Self {
+            at_infinity: at_infinity(&list),
             list,
             groups,
             emission_group,
@@ -276,11 +281,14 @@ impl Lights {
     /// Whether any light is a surface rays can meet: a ball (a sphere
     /// light of non-zero radius) or an area light.
     pub fn any_surface(&self) -> bool {
-        self.list.iter().any(|l| match l {
-            Light::Sphere(s) => !s.is_point(),
-            Light::Area(_) => true,
-            Light::Distant(_) | Light::Dome(_) => false,
-        })
+        self.list.iter().any(Light::is_surface)
+    }
+
+    /// The indices of the lights at infinity (distant lights and domes):
+    /// the ones an escaping ray reaches.
+    #[inline]
+    pub fn at_infinity(&self) -> &[u32] {
+        &self.at_infinity
     }
 
     /// The lights with positions given relative to `origin` (render space
@@ -300,13 +308,14 @@ impl Lights {
     /// Drops lights that deliver nothing (zero irradiance or radiance), so
     /// they cost nothing either; the others keep their order and groups.
     pub fn pruned(self) -> Self {
-        let (list, groups) = self
+        let (list, groups): (Vec<Light>, Vec<u8>) = self
             .list
             .into_iter()
             .zip(self.groups)
             .filter(|(l, _)| !l.is_black())
             .unzip();
         Self {
+            at_infinity: at_infinity(&list),
             list,
             groups,
             emission_group: self.emission_group,

@@ -1,0 +1,260 @@
+//! What a light tree knows of a light or of a cluster of them (Conty
+//! Estevez and Kulla 2018; pbrt-v4's `LightBounds`, Cycles' light tree):
+//! a box holding them, a cone holding the directions they emit about
+//! (`cos_theta_o` about `axis`, their emission spreading `theta_e` past
+//! it) and their strength `phi`, the luminance of the intensity each sends
+//! along its brightest direction, summed. From these, an importance at a
+//! point (`phi cos theta' / d^2`, `theta'` the least angle between the
+//! cone and the direction to the point) and along a ray segment (`phi`
+//! times the angle the segment spans seen from the box's centre over its
+//! distance from the segment, the integral of `1 / d^2` along it, as
+//! equi-angular sampling's reach and Cycles' volume segments).
+//! Volumes have no normal: no incidence term.
+
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use super::{AreaLight, AreaShape};
+
+/// The least squared distance an importance divides by, so that a point
+/// at a point light weighs finitely.
+const MIN_DISTANCE2: f32 = 1e-12;
+
+/// The bounds of one light or of a cluster.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightBounds {
+    pub min: Vec3,
+    pub max: Vec3,
+    pub phi: f32,
+    /// The cone's axis (unit; any where the cone is the whole sphere).
+    pub axis: Vec3,
+    pub cos_theta_o: f32,
+    pub cos_theta_e: f32,
+}
+
+impl LightBounds {
+    /// A ball (or a point, radius 0) emitting alike every way, of
+    /// intensity luminance `phi`.
+    pub fn ball(centre: Vec3, radius: f32, phi: f32) -> Self {
+        Self {
+            min: centre - Vec3::splat(radius),
+            max: centre + Vec3::splat(radius),
+            phi,
+            axis: Vec3::Z,
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+        }
+    }
+
+    /// An area light: a flat shape emitting about its normal over a
+    /// hemisphere, a cylinder's side every way; `phi` its radiance's
+    /// luminance times its largest projected area.
+    pub fn area(a: &AreaLight) -> Self {
+        let r = a.half_extent();
+        let l = crate::spectrum::luminance(a.radiance());
+        let (cos_theta_o, phi) = match a.shape() {
+            AreaShape::Cylinder => (-1.0, l * a.area() / PI),
+            AreaShape::Rect | AreaShape::Disk => (1.0, l * a.area()),
+        };
+        Self {
+            min: a.centre() - r,
+            max: a.centre() + r,
+            phi,
+            axis: a.normal(),
+            cos_theta_o,
+            cos_theta_e: 0.0,
+        }
+    }
+
+    #[inline]
+    pub fn centre(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+
+    /// Half the box's diagonal: the radius of a ball holding it.
+    #[inline]
+    fn radius(&self) -> f32 {
+        0.5 * (self.max - self.min).length()
+    }
+
+    /// The bounds of both clusters.
+    pub fn union(&self, other: &Self) -> Self {
+        if self.phi <= 0.0 {
+            return *other;
+        }
+        if other.phi <= 0.0 {
+            return *self;
+        }
+        let (axis, cos_theta_o) =
+            cone_union((self.axis, self.cos_theta_o), (other.axis, other.cos_theta_o));
+        Self {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+            phi: self.phi + other.phi,
+            axis,
+            cos_theta_o,
+            cos_theta_e: self.cos_theta_e.min(other.cos_theta_e),
+        }
+    }
+
+    /// The cosine of the least angle between the cone and the direction
+    /// from the box toward `p`, at squared distance `d2` from its centre,
+    /// or `None` where no emission of the cluster reaches `p`.
+    #[inline]
+    fn cos_theta_prime(&self, p: Vec3, d2: f32) -> Option<f32> {
+        if self.cos_theta_o <= -1.0 {
+            // Every way: the cone holds every direction.
+            return Some(1.0);
+        }
+        let r = self.radius();
+        let wi = (p - self.centre()).normalize_or_zero();
+        let cos_w = self.axis.dot(wi);
+        let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
+        // The cone of directions the box subtends from `p`.
+        let cos_b = if d2 <= r * r {
+            -1.0
+        } else {
+            (1.0 - r * r / d2).max(0.0).sqrt()
+        };
+        let sin_b = (1.0 - cos_b * cos_b).max(0.0).sqrt();
+        let sin_o = (1.0 - self.cos_theta_o * self.cos_theta_o).max(0.0).sqrt();
+        let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, self.cos_theta_o);
+        let sin_x = (1.0 - cos_x * cos_x).max(0.0).sqrt();
+        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+        (cos_p > self.cos_theta_e).then_some(cos_p)
+    }
+
+    /// The cluster's importance for a point at `p`.
+    #[inline]
+    pub fn importance(&self, p: Vec3) -> f32 {
+        if self.phi <= 0.0 {
+            return 0.0;
+        }
+        let true_d2 = (p - self.centre()).length_squared();
+        let Some(cos_p) = self.cos_theta_prime(p, true_d2) else {
+            return 0.0;
+        };
+        let r = self.radius();
+        let d2 = true_d2.max(r * r).max(MIN_DISTANCE2);
+        self.phi * cos_p / d2
+    }
+
+    /// The cluster's importance for the ray segment from `o` along unit
+    /// `dir` over `[t0, t1]`: `phi` times `integral dt / d^2` along the
+    /// segment, its distance from the box's centre at least the box's
+    /// radius (the emission's orientation is not weighed: the segment
+    /// sees the cluster from many sides).
+    #[inline]
+    pub fn segment_importance(&self, o: Vec3, dir: Vec3, t0: f32, t1: f32) -> f32 {
+        if self.phi <= 0.0 || t1 <= t0 {
+            return 0.0;
+        }
+        let to_c = self.centre() - o;
+        let delta = to_c.dot(dir);
+        let h = (to_c - delta * dir)
+            .length()
+            .max(self.radius())
+            .max(MIN_DISTANCE2.sqrt());
+        let span = ((t1 - delta) / h).atan() - ((t0 - delta) / h).atan();
+        self.phi * span.max(0.0) / h
+    }
+}
+
+/// `cos(max(0, a - b))` from the sines and cosines of `a` and `b`.
+#[inline]
+fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if cos_a > cos_b {
+        1.0
+    } else {
+        cos_a * cos_b + sin_a * sin_b
+    }
+}
+
+/// The least cone holding cones `a` and `b` (axis, cosine of the
+/// half-angle), as pbrt-v4's `DirectionCone::Union`.
+fn cone_union(a: (Vec3, f32), b: (Vec3, f32)) -> (Vec3, f32) {
+    let whole = (Vec3::Z, -1.0);
+    if a.1 <= -1.0 || b.1 <= -1.0 {
+        return whole;
+    }
+    let theta_a = a.1.clamp(-1.0, 1.0).acos();
+    let theta_b = b.1.clamp(-1.0, 1.0).acos();
+    let theta_d = a.0.dot(b.0).clamp(-1.0, 1.0).acos();
+    if (theta_d + theta_b).min(PI) <= theta_a {
+        return a;
+    }
+    if (theta_d + theta_a).min(PI) <= theta_b {
+        return b;
+    }
+    let theta_o = 0.5 * (theta_a + theta_d + theta_b);
+    if theta_o >= PI {
+        return whole;
+    }
+    let theta_r = theta_o - theta_a;
+    let wr = a.0.cross(b.0);
+    if wr.length_squared() < 1e-12 {
+        return whole;
+    }
+    let axis = glam::Quat::from_axis_angle(wr.normalize(), theta_r) * a.0;
+    (axis.normalize(), theta_o.cos())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cluster's importance is at least each of its lights', at points
+    /// around and between them (the bound a tree's pick relies on not to
+    /// starve a light), and a flat light has none behind it.
+    #[test]
+    fn a_cluster_bounds_its_lights() {
+        let area = |c: Vec3, n: Vec3| {
+            AreaLight::new(AreaShape::Rect, c, Vec3::X, Vec3::Y, n, Vec3::ONE)
+        };
+        let lights = [
+            LightBounds::ball(Vec3::ZERO, 0.0, 2.0),
+            LightBounds::ball(Vec3::new(4.0, 1.0, 0.0), 0.5, 1.0),
+            LightBounds::area(&area(Vec3::new(0.0, 3.0, 0.0), Vec3::Z)),
+            LightBounds::area(&area(Vec3::new(2.0, 3.0, 1.0), Vec3::X)),
+        ];
+        let flat = LightBounds::area(&area(Vec3::ZERO, Vec3::Z));
+        assert_eq!(flat.importance(Vec3::new(0.3, 0.2, -4.0)), 0.0);
+        assert!(flat.importance(Vec3::new(0.3, 0.2, 2.0)) > 0.0);
+        let mut rng = cirrus_testkit::SplitMix64(3);
+        for a in 0..lights.len() {
+            for b in a + 1..lights.len() {
+                let u = lights[a].union(&lights[b]);
+                for _ in 0..2000 {
+                    let p = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 20.0 - 10.0;
+                    let (ia, ib, iu) = (
+                        lights[a].importance(p),
+                        lights[b].importance(p),
+                        u.importance(p),
+                    );
+                    assert!(
+                        iu > 0.0 || (ia == 0.0 && ib == 0.0),
+                        "{a} {b} at {p}: {iu} {ia} {ib}"
+                    );
+                    let (o, d) = (p, Vec3::new(0.3, -0.5, 0.8).normalize());
+                    let (sa, sb) = (
+                        lights[a].segment_importance(o, d, 0.0, 15.0),
+                        lights[b].segment_importance(o, d, 0.0, 15.0),
+                    );
+                    let su = u.segment_importance(o, d, 0.0, 15.0);
+                    assert!(su > 0.0 || (sa == 0.0 && sb == 0.0));
+                }
+            }
+        }
+    }
+
+    /// A point light's segment importance is `phi` times equi-angular
+    /// sampling's reach, `(theta_b - theta_a) / h`.
+    #[test]
+    fn a_points_segment_importance_is_its_reach() {
+        let b = LightBounds::ball(Vec3::new(3.0, 2.0, 0.0), 0.0, 5.0);
+        let got = b.segment_importance(Vec3::ZERO, Vec3::X, 0.0, 10.0);
+        let want = 5.0 * ((7.0f32 / 2.0).atan() - (-3.0f32 / 2.0).atan()) / 2.0;
+        assert!((got / want - 1.0).abs() < 1e-5, "{got} vs {want}");
+    }
+}
