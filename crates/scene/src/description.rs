@@ -101,7 +101,7 @@ declare_settings! {
     /// media (a coarse shadow grid; half the shadow rays under a sun and a
     /// sky, and few deep in a thick cloud), or to every light; `auto` picks
     /// one under constant domes (a constant sky), every light under a map,
-    /// and one past 8 lights, weighed by what each sends toward the vertex
+    /// and one past 8 lights, picked by a light tree
     /// (`uniform`: one picked uniformly, the baseline).
     light_sampling: LightSampling, flag(long, value_enum), default(LightSampling::default()),
         example(LightSampling::All);

@@ -340,3 +340,71 @@ fn mutated_usdlux_stages_error_cleanly_or_render_finite_images() {
         assert!(tally.errors > 15 && tally.renders > 15, "{tally:?}");
     });
 }
+
+/// `n` lights of the kinds a light tree holds (points, balls, spots,
+/// rects, discs), as `[[light]]` tables: spread over and around the
+/// cloud, or all at one place (`stacked`: a tree whose clusters have no
+/// extent), their intensities ordinary or from 1e-30 to 1e27 and zero
+/// (`extreme`: the largest a light takes, whose importances overflow f32).
+fn many_lights(rng: &mut SplitMix64, n: usize, stacked: bool, extreme: bool) -> String {
+    let mut text = format!("[[volume]]\nfile = {:?}\n", cloud());
+    let kinds = ["point", "sphere", "spot", "rect", "disk"];
+    for _ in 0..n {
+        let kind = pick(rng, &kinds);
+        let p = if stacked {
+            [150.0, 80.0, 100.0]
+        } else {
+            [0, 1, 2].map(|_| rng.unit() * 400.0 - 50.0)
+        };
+        let intensity = if extreme {
+            pick(rng, &["0.0", "1e-30", "1e-7", "1.0", "1e12", "1e27"]).to_string()
+        } else {
+            format!("{}", 100.0 + 1000.0 * rng.unit())
+        };
+        text += &format!(
+            "[[light]]\ntype = \"{kind}\"\nposition = [{}, {}, {}]\nintensity = {intensity}\n",
+            p[0], p[1], p[2]
+        );
+        match kind {
+            "sphere" => text += "radius = 2\n",
+            "spot" => text += "direction = [0.3, -1, 0.2]\ncone_angle = 30\n",
+            "rect" | "disk" => {
+                let d = [0, 1, 2].map(|_| rng.unit() * 2.0 - 1.0);
+                let size = if kind == "rect" {
+                    "width = 20\nheight = 10"
+                } else {
+                    "radius = 5"
+                };
+                text += &format!("direction = [{}, {}, {}]\n{size}\n", d[0], d[1], d[2]);
+            }
+            _ => {}
+        }
+    }
+    text
+}
+
+/// Scenes of 9 to 10,000 lights, the sizes past the few-light pick that
+/// a light tree picks among (balanced, stacked at one point, with
+/// overflowing strengths), error cleanly or render finite images: never a
+/// panic or a hang; the ordinary ones are not black.
+#[test]
+fn thousands_of_lights_render_finite_images() {
+    within_budget(|| {
+        let d = dir("many");
+        let mut rng = SplitMix64(52);
+        let mut tally = Tally::default();
+        for n in [9, 33, 1000, 10_000] {
+            for (stacked, extreme) in [(false, false), (true, false), (false, true)] {
+                let p = d.join(format!("many{n}_{stacked}_{extreme}.toml"));
+                std::fs::write(&p, many_lights(&mut rng, n, stacked, extreme)).unwrap();
+                let black = tally.black;
+                run_case(&p, &mut tally);
+                if !stacked && !extreme {
+                    assert_eq!(tally.black, black, "{n} lights: a black image");
+                }
+            }
+        }
+        eprintln!("many lights: {tally:?}");
+        assert_eq!(tally.renders, 12, "{tally:?}");
+    });
+}

@@ -12,10 +12,10 @@ settings_enum! {
         Auto = "auto",
         /// Every light, one sample each.
         All = "all",
-        // Past 8 lights the pick is many_lights.rs's.
+        // Past 8 lights the pick is many_lights.rs's (a light tree).
         /// One light (or, deep in the media, most often none), picked in
         /// proportion to its in-scattered radiance at the vertex seen through
-        /// the media (past 8 lights, by what each sends toward the vertex).
+        /// the media (past 8 lights, by a light tree).
         One = "one",
         /// One light picked uniformly at random (the baseline the weighed
         /// pick is measured against).

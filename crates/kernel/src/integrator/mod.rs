@@ -14,6 +14,7 @@ mod light_sampling;
 mod light_tree;
 mod many_lights;
 mod march;
+mod mis;
 mod path;
 mod path_equiangular;
 mod path_flight;
@@ -40,7 +41,8 @@ use crate::counters::Counters;
 use crate::light::GroupRadiance;
 use crate::light::Lights;
 use crate::ray::Ray;
-use crate::sampling::{power_heuristic, Rng, SampleStream};
+use crate::sampling::{Rng, SampleStream};
+use mis::Strategies;
 use light_choice::{LightChoice, LightSampler};
 
 settings_enum! {
@@ -133,7 +135,9 @@ pub(crate) fn escaped_radiance(
         light.count_sample(c);
         if let Some((radiance, pdf)) = light.escaped(dir) {
             let weight = phase_pdf.map_or(1.0, |(p, choice, sampler)| {
-                power_heuristic(p, sampler.probability(choice, i) * pdf)
+                Strategies::drawn_with(p)
+                    .or(sampler.probability(choice, i) * pdf)
+                    .weight()
             });
             l.add(lights.group(i), radiance * weight);
         }

@@ -39,7 +39,8 @@ use super::per_light::MAX_PICKED_LIGHTS;
 use crate::light::{LightBounds, Lights};
 use crate::medium::Media;
 use crate::ray::Ray;
-use crate::sampling::{power_heuristic, SampleStream};
+use super::mis::Strategies;
+use crate::sampling::SampleStream;
 use crate::spectrum::Spectrum;
 use crate::tracking::transmittance;
 
@@ -111,7 +112,7 @@ impl EquiAngular {
 /// over the span (see the module documentation).
 #[inline]
 fn weight(pdf: f32, len: f32) -> f32 {
-    power_heuristic(pdf, 1.0 / len)
+    Strategies::drawn_with(pdf).or(1.0 / len).weight()
 }
 
 /// A segment's span in the media, `[t0, t1]`, within `t_max`.

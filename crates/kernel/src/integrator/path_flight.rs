@@ -24,7 +24,8 @@ use crate::counters::Counters;
 use crate::light::LightHit;
 use crate::medium::Media;
 use crate::ray::Ray;
-use crate::sampling::{power_heuristic, Draw, SampleStream};
+use super::mis::Strategies;
+use crate::sampling::{Draw, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::tracking::{sample_free_flight, FreeFlight};
 
@@ -129,7 +130,9 @@ impl<M: Media> PathTracer<'_, M> {
         let weight = match &path.escape {
             Escape::Full => 1.0,
             Escape::Mis(pdf, choice) => {
-                power_heuristic(*pdf, self.sampler.probability(choice, h.light) * h.pdf)
+                Strategies::drawn_with(*pdf)
+                .or(self.sampler.probability(choice, h.light) * h.pdf)
+                .weight()
             }
         };
         let e = path.beta * h.radiance * weight;

@@ -12,7 +12,8 @@ use super::LightParts;
 use crate::counters::Counters;
 use crate::light::{Light, LightSample};
 use crate::medium::Media;
-use crate::sampling::{power_heuristic, Draw, SampleStream};
+use super::mis::Strategies;
+use crate::sampling::{Draw, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::tracking::transmittance;
 
@@ -150,7 +151,7 @@ impl<M: Media> PathTracer<'_, M> {
                 let light_pdf = pick * light_pdf;
                 // Every phase function is sampled exactly: its pdf is f.
                 let w = if v.mis {
-                    power_heuristic(light_pdf, f)
+                    Strategies::drawn_with(light_pdf).or(f).weight()
                 } else {
                     1.0
                 };

@@ -11,7 +11,7 @@ use super::light_choice::LightChoice;
 use super::{LightParts, Sample};
 use crate::phase::Phase;
 use crate::ray::Ray;
-use crate::sampling::power_heuristic;
+use super::mis::Strategies;
 
 /// What the lights at infinity a ray escapes to add.
 #[derive(Clone, Copy, Debug)]
@@ -109,7 +109,9 @@ impl Arrival {
     #[inline]
     pub fn sun_weight(self, pick: f32) -> f32 {
         if self.sunward_pdf > 0.0 {
-            power_heuristic(self.scatter_pdf * pick, self.sunward_pdf)
+            Strategies::drawn_with(self.scatter_pdf * pick)
+                .or(self.sunward_pdf)
+                .weight()
         } else {
             1.0
         }

@@ -49,7 +49,8 @@ use crate::counters::Counters;
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
-use crate::sampling::{power_heuristic, SampleStream};
+use super::mis::Strategies;
+use crate::sampling::SampleStream;
 use crate::spectrum::Spectrum;
 use crate::tracking::{sample_free_flight, transmittance, FreeFlight};
 
@@ -82,7 +83,7 @@ fn keep_probability(q: f32, f: f32, pick: f32, lit: f32) -> f32 {
 /// the next vertex. [`Arrival::sun_weight`] is its complement.
 #[inline]
 fn sunward_weight(q: f32, f: f32, pick: f32) -> f32 {
-    power_heuristic(q, f * pick)
+    Strategies::drawn_with(q).or(f * pick).weight()
 }
 
 /// The sunward strategy at a vertex reached along `dir_in` with phase
@@ -210,13 +211,13 @@ impl<M: Media> PathTracer<'_, M> {
                 let mis = if last {
                     1.0
                 } else {
-                    power_heuristic(pick * light_pdf, f_sun)
+                    Strategies::drawn_with(pick * light_pdf).or(f_sun).weight()
                 };
                 mis / light_pdf
             }
             Some(_) => return Vec3::ZERO,
         };
-        c.nee_rays_distant += 1;
+        self.lights.get(light).count_shadow_ray(c);
         let shadow = ray.spawn(p, s.to_light);
         let tr = transmittance::<S, M>(self.estimator, self.medium, &shadow, f32::INFINITY, rng, c);
         beta * s.radiance * (f_sun * light_weight * weight * tr.rgb())

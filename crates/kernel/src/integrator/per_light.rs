@@ -14,9 +14,8 @@ pub const MIN_PROBABILITY: f32 = 0.05;
 /// The pick is computed at every vertex and carried to the next one for
 /// the escaped ray's weight, so its probabilities are a plain array on the
 /// stack: a growable one (with its spill checks and drops) cost the thick
-/// benchmark cloud a sixth of its render time. Many lights want a sampler
-/// that does not weigh each of them at every vertex (a light tree) rather
-/// than a longer array.
+/// benchmark cloud a sixth of its render time. Past it a light tree picks
+/// (`many_lights.rs`), which does not weigh each light at every vertex.
 pub const MAX_PICKED_LIGHTS: usize = 8;
 
 /// One value per light, in the order of [`Lights`](crate::Lights) (at most
