@@ -10,6 +10,16 @@ image's mean), and the efficiency 1 / (MSE x time) relative to `uniform`.
 
     python3 tools/many_lights.py [CIRRUS] [--spp N] [--ref-spp N]
 
+With `--embers`, the light tree's benchmark instead: embers in smoke (the
+same fog lit by 10 and by 10,000 point lights in the lower part of the
+cloud, their total power fixed), printing the time per sample with 10,000
+lights over that with 10, and at 10,000 lights the error of the weighed
+pick (the light tree) against the uniform pick at equal time; with
+`--baseline OTHER_CIRRUS` the same figures for another build (today's
+pick) beside them, the two builds run alternately.
+
+    python3 tools/many_lights.py [CIRRUS] --embers [--baseline CIRRUS] [--spp N] [--ref-spp N]
+
 Needs numpy and OpenEXR (`pip install numpy OpenEXR`).
 """
 
@@ -68,13 +78,91 @@ radiance = [0.002, 0.003, 0.005]
 {CLOUD_FOG}"""
 
 
+def embers(n: int) -> list[dict]:
+    """`n` point lamps (embers) at random in the lower third of the
+    cloud's box, orange, their powers spread over a factor of ten and
+    their total fixed."""
+    rng = np.random.default_rng(7 + n)
+    lo, hi = LO.copy(), HI.copy()
+    hi[1] = lo[1] + (hi[1] - lo[1]) / 3.0
+    powers = 10.0 ** rng.uniform(0.0, 1.0, n)
+    powers *= 40000.0 / powers.sum()
+    return [{
+        "type": "point",
+        "name": "ember",
+        "position": [float(x) for x in lo + rng.random(3) * (hi - lo)],
+        "color": [c * float(w) for c in (1.0, 0.45, 0.12)],
+    } for w in powers]
+
+
+def ember_scene(n: int, spp: int, sampling: str, seed: int) -> str:
+    lights = "".join(
+        "[[light]]\n" + "".join(f"{k} = {json.dumps(v)}\n" for k, v in l.items()) for l in embers(n)
+    )
+    return f"""[camera]
+res = "160x100"
+from = [150, 83, -250]
+to = [150, 83, 100]
+[render]
+spp = {spp}
+seed = {seed}
+light_sampling = "{sampling}"
+{lights}
+{CLOUD_FOG}"""
+
+
+def ember_benchmark(a: argparse.Namespace) -> None:
+    d = Path(tempfile.mkdtemp(prefix="cirrus-embers-"))
+    builds = [("this build", a.cirrus)] + ([("baseline", a.baseline)] if a.baseline else [])
+    pixels = 160 * 100
+    # Time per sample: 10 and 10,000 lights, the builds alternating, the
+    # least of three runs each (the render's wall time over its samples).
+    per_sample = {}
+    for rep in range(3):
+        for label, exe in builds:
+            for n in (10, 10000):
+                _, t = render_rgb(exe, ember_scene(n, a.spp, "auto", 1), d, f"t{n}")
+                key = (label, n)
+                per_sample[key] = min(per_sample.get(key, math.inf), t / (a.spp * pixels))
+    for label, _ in builds:
+        t10, t10k = per_sample[(label, 10)], per_sample[(label, 10000)]
+        print(f"{label:10s} time per sample: 10 lights {t10 * 1e9:7.1f} ns, 10,000 lights "
+              f"{t10k * 1e9:7.1f} ns: {t10k / t10:5.2f}x")
+    # Error at equal time, 10,000 lights: the weighed pick (this build's
+    # reference) against the uniform pick.
+    ref, _ = render_rgb(a.cirrus, ember_scene(10000, a.ref_spp, "auto", 1000), d, "ref")
+    mean = float(ref.mean())
+    for label, exe in builds:
+        rows = {}
+        for sampling in ("uniform", "auto"):
+            errs, times = [], []
+            for seed in (1, 2, 3):
+                img, t = render_rgb(exe, ember_scene(10000, a.spp, sampling, seed), d, f"e{sampling}")
+                errs.append(np.mean((img - ref) ** 2))
+                times.append(t)
+            rows[sampling] = (float(np.mean(errs)), float(np.mean(times)))
+        (mse_u, t_u), (mse_w, t_w) = rows["uniform"], rows["auto"]
+        # At equal time the MSE scales as 1 / time.
+        ratio = (mse_u * t_u) / (mse_w * t_w)
+        for sampling, (mse, t) in rows.items():
+            print(f"{label:10s} 10,000 lights {sampling:8s} time {t:6.2f} s  relative RMSE "
+                  f"{math.sqrt(mse) / mean:7.4f}")
+        print(f"{label:10s} at equal time the weighed pick's MSE is {ratio:6.1f}x lower than "
+              f"the uniform pick's (RMSE {math.sqrt(ratio):5.2f}x)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("cirrus", nargs="?", default=str(REPO / "target" / "release" / "cirrus"))
     ap.add_argument("--spp", type=int, default=32)
     ap.add_argument("--ref-spp", type=int, default=1024)
     ap.add_argument("--lights", default="1,10,100")
+    ap.add_argument("--embers", action="store_true", help="the light tree's benchmark")
+    ap.add_argument("--baseline", help="another build, measured beside (with --embers)")
     a = ap.parse_args()
+    if a.embers:
+        ember_benchmark(a)
+        return
     d = Path(tempfile.mkdtemp(prefix="cirrus-many-"))
     for n in (int(x) for x in a.lights.split(",")):
         ref, _ = render_rgb(a.cirrus, scene(n, a.ref_spp, "auto", 1000), d, f"ref{n}")
