@@ -95,7 +95,7 @@ def embers(n: int) -> list[dict]:
     } for w in powers]
 
 
-def ember_scene(n: int, spp: int, sampling: str, seed: int) -> str:
+def ember_scene(n: int, spp: int, sampling: str, seed: int, distance: str = "auto") -> str:
     lights = "".join(
         "[[light]]\n" + "".join(f"{k} = {json.dumps(v)}\n" for k, v in l.items()) for l in embers(n)
     )
@@ -107,6 +107,7 @@ to = [150, 83, 100]
 spp = {spp}
 seed = {seed}
 light_sampling = "{sampling}"
+distance_sampling = "{distance}"
 {lights}
 {CLOUD_FOG}"""
 
@@ -121,7 +122,7 @@ def ember_benchmark(a: argparse.Namespace) -> None:
     for rep in range(3):
         for label, exe in builds:
             for n in (10, 10000):
-                _, t = render_rgb(exe, ember_scene(n, a.spp, "auto", 1), d, f"t{n}")
+                _, t = render_rgb(exe, ember_scene(n, a.spp, "auto", 1, a.distance), d, f"t{n}")
                 key = (label, n)
                 per_sample[key] = min(per_sample.get(key, math.inf), t / (a.spp * pixels))
     for label, _ in builds:
@@ -130,14 +131,14 @@ def ember_benchmark(a: argparse.Namespace) -> None:
               f"{t10k * 1e9:7.1f} ns: {t10k / t10:5.2f}x")
     # Error at equal time, 10,000 lights: the weighed pick (this build's
     # reference) against the uniform pick.
-    ref, _ = render_rgb(a.cirrus, ember_scene(10000, a.ref_spp, "auto", 1000), d, "ref")
+    ref, _ = render_rgb(a.cirrus, ember_scene(10000, a.ref_spp, "auto", 1000, a.distance), d, "ref")
     mean = float(ref.mean())
     for label, exe in builds:
         rows = {}
         for sampling in ("uniform", "auto"):
             errs, times = [], []
             for seed in (1, 2, 3):
-                img, t = render_rgb(exe, ember_scene(10000, a.spp, sampling, seed), d, f"e{sampling}")
+                img, t = render_rgb(exe, ember_scene(10000, a.spp, sampling, seed, a.distance), d, f"e{sampling}")
                 errs.append(np.mean((img - ref) ** 2))
                 times.append(t)
             rows[sampling] = (float(np.mean(errs)), float(np.mean(times)))
@@ -159,6 +160,8 @@ def main() -> None:
     ap.add_argument("--lights", default="1,10,100")
     ap.add_argument("--embers", action="store_true", help="the light tree's benchmark")
     ap.add_argument("--baseline", help="another build, measured beside (with --embers)")
+    ap.add_argument("--distance", default="auto",
+                    help="distance sampling of the embers' renders (auto, equiangular)")
     a = ap.parse_args()
     if a.embers:
         ember_benchmark(a)

@@ -426,3 +426,64 @@ fn area_lights_take_their_size_orientation_and_normalisation() {
     assert!((disk.area() - std::f32::consts::PI * 0.25).abs() < 1e-6);
     assert_eq!(disk.radiance(), Vec3::new(1.0, 0.5, 0.25));
 }
+
+/// Forty balls and panels of different strengths through a thin fog,
+/// rendered with the light tree's pick (`one`: past 8 lights) and with the
+/// uniform pick (whose expectation is the image): the two image means
+/// agree within four standard errors (from the pixels' sample variances),
+/// and the tree's pick is the less noisy. The balls are met by scattered
+/// rays too, so their MIS weights take the tree's probability of the
+/// light, which must be the pick's for the means to agree.
+#[test]
+fn a_light_trees_image_is_the_uniform_picks() {
+    let mut rng = cirrus_testkit::SplitMix64(40);
+    let mut lights = String::new();
+    for k in 0..40 {
+        let p = [0, 1, 2].map(|_| 40.0 + 200.0 * rng.unit());
+        let strength = 500.0 + 4000.0 * rng.unit();
+        lights += &if k % 4 == 0 {
+            format!(
+                "[[light]]\ntype = \"rect\"\nposition = [{}, {}, {}]\ndirection = [0, -1, 0.3]\n\
+                 width = 12\nheight = 12\nintensity = {}\n",
+                p[0],
+                p[1],
+                p[2],
+                strength / 100.0
+            )
+        } else {
+            format!(
+                "[[light]]\ntype = \"sphere\"\nposition = [{}, {}, {}]\nradius = 6\nintensity = {}\n",
+                p[0], p[1], p[2], strength / 100.0
+            )
+        };
+    }
+    let render = |sampling: cirrus_render::LightSampling| {
+        let mut s = scene(&lights);
+        s.apply(&Overrides {
+            density_scale: Some(cirrus_scene::description::Colour::Grey(0.05)),
+            res: Some((32, 24)),
+            spp: Some(96),
+            camera_from: Some([150.0, 83.0, -250.0]),
+            camera_to: Some([150.0, 83.0, 100.0]),
+            light_sampling: Some(sampling),
+            ..Default::default()
+        });
+        s.render().unwrap().image
+    };
+    // The image's mean (green) and its standard error.
+    let stats = |i: &cirrus_render::Image| {
+        let n = i.rgba.len() as f64;
+        let mean = i.rgba.iter().map(|p| f64::from(p[1])).sum::<f64>() / n;
+        let var: f64 = i.variance.iter().map(|v| f64::from(v[1])).sum::<f64>() / f64::from(i.spp);
+        (mean, var.sqrt() / n)
+    };
+    let (tree, tree_se) = stats(&render(cirrus_render::LightSampling::One));
+    let (uniform, uniform_se) = stats(&render(cirrus_render::LightSampling::Uniform));
+    let se = (tree_se * tree_se + uniform_se * uniform_se).sqrt();
+    assert!(tree > 10.0 * se, "a lit image: {tree} +- {tree_se}");
+    assert!(
+        (tree - uniform).abs() < 4.0 * se,
+        "tree {tree} +- {tree_se}, uniform {uniform} +- {uniform_se}"
+    );
+    assert!(tree_se < uniform_se, "{tree_se} vs {uniform_se}");
+}

@@ -1,9 +1,11 @@
 //! A light tree (Conty Estevez and Kulla 2018, as Cycles' light tree and
 //! pbrt-v4's `BVHLightSampler`): a binary tree over the lights in the
 //! scene, each node holding its lights' [`LightBounds`]. A pick walks from
-//! the root, at each node taking a child with probability in proportion
-//! to its importance for what is lit (a point, or a ray segment for a
-//! volume's equi-angular sample), so a vertex finds the lights that
+//! the root, at each node taking a child by its importance for what is
+//! lit (a point, or a ray segment for a volume's equi-angular sample):
+//! with a least and a greatest importance for each child (a point's
+//! distance to the box's far corner and to its near side), the mean of
+//! the shares each gives, as Cycles does, so a vertex finds the lights that
 //! matter in `log n` steps whatever their number; the probability of a
 //! given light is the product of the choices on the way to its leaf, which
 //! the tree recomputes by walking the leaf's recorded trail (for MIS).
@@ -97,7 +99,12 @@ impl LightTree {
 
     /// Appends the subtree over `leaves`, reached by `bits` at `depth`,
     /// and returns its bounds.
-    fn build(&mut self, leaves: &mut [(Vec3, u32, LightBounds)], bits: u64, depth: u8) -> LightBounds {
+    fn build(
+        &mut self,
+        leaves: &mut [(Vec3, u32, LightBounds)],
+        bits: u64,
+        depth: u8,
+    ) -> LightBounds {
         let at = self.nodes.len();
         if let [(_, light, bounds)] = *leaves {
             self.nodes.push(Node {
@@ -136,7 +143,11 @@ impl LightTree {
     /// each node, and its probability; `None` where no light brings
     /// anything.
     #[inline]
-    pub fn pick(&self, importance: impl Fn(&LightBounds) -> f32, u: f32) -> Option<(usize, f32)> {
+    pub fn pick(
+        &self,
+        importance: impl Fn(&LightBounds) -> (f32, f32),
+        u: f32,
+    ) -> Option<(usize, f32)> {
         let (mut node, mut pmf, mut u) = (0usize, 1.0f32, u);
         loop {
             match self.nodes[node].kind {
@@ -164,7 +175,7 @@ impl LightTree {
     /// The probability that [`Self::pick`] with `importance` picks light
     /// `i` (0 for a light it does not hold).
     #[inline]
-    pub fn probability(&self, importance: impl Fn(&LightBounds) -> f32, i: usize) -> f32 {
+    pub fn probability(&self, importance: impl Fn(&LightBounds) -> (f32, f32), i: usize) -> f32 {
         let Some(Some(trail)) = self.trails.get(i) else {
             return 0.0;
         };
@@ -192,11 +203,22 @@ impl LightTree {
     }
 }
 
-/// The probability of taking the first of two children of importances
-/// `a` and `b`; `None` where neither brings anything. An infinite
-/// importance (a vertex at a point light) takes that child.
+/// The probability of taking the first of two children whose least and
+/// greatest importances are `a` and `b`: the mean of the shares by each
+/// (one alone where the other says nothing); `None` where neither child
+/// brings anything.
 #[inline]
-fn first_child_probability(a: f32, b: f32) -> Option<f32> {
+fn first_child_probability(a: (f32, f32), b: (f32, f32)) -> Option<f32> {
+    match (share(a.0, b.0), share(a.1, b.1)) {
+        (Some(least), Some(most)) => Some(0.5 * (least + most)),
+        (one, other) => one.or(other),
+    }
+}
+
+/// The share of importance `a` against `b`; `None` where neither is
+/// positive. An infinite importance takes its child.
+#[inline]
+fn share(a: f32, b: f32) -> Option<f32> {
     let clean = |x: f32| if x > 0.0 { x } else { 0.0 };
     let (a, b) = (clean(a), clean(b));
     match (a.is_infinite(), b.is_infinite()) {
@@ -223,7 +245,14 @@ mod tests {
                 let (p, i) = (v(100.0), 1.0 + 9.0 * v(1.0).x);
                 if k % 7 == 3 {
                     let normal = v(2.0) - Vec3::ONE;
-                    let a = AreaLight::new(AreaShape::Rect, p, Vec3::X, Vec3::Z, normal, Vec3::splat(i));
+                    let a = AreaLight::new(
+                        AreaShape::Rect,
+                        p,
+                        Vec3::X,
+                        Vec3::Z,
+                        normal,
+                        Vec3::splat(i),
+                    );
                     a.into()
                 } else {
                     SphereLight::new(p, 0.2 * (k % 3) as f32, Vec3::splat(i)).into()
@@ -246,12 +275,21 @@ mod tests {
         let members: Vec<usize> = (0..lights.len()).collect();
         let tree = LightTree::new(&lights, &members).unwrap();
         assert_eq!(tree.len(), 60, "the sun is left out");
-        for p in [Vec3::splat(50.0), Vec3::new(-30.0, 120.0, 40.0), Vec3::new(10.0, 5.0, 90.0)] {
-            let imp = |b: &LightBounds| b.importance(p);
-            let pmf: Vec<f32> = (0..lights.len()).map(|i| tree.probability(imp, i)).collect();
+        for p in [
+            Vec3::splat(50.0),
+            Vec3::new(-30.0, 120.0, 40.0),
+            Vec3::new(10.0, 5.0, 90.0),
+        ] {
+            let imp = |b: &LightBounds| b.importance_range(p);
+            let pmf: Vec<f32> = (0..lights.len())
+                .map(|i| tree.probability(imp, i))
+                .collect();
             for (i, &q) in pmf.iter().enumerate().take(60) {
                 let own = lights.get(i).bounds().unwrap().importance(p);
-                assert!(own == 0.0 || q > 0.0, "light {i} at {p}: {own} but never picked");
+                assert!(
+                    own == 0.0 || q > 0.0,
+                    "light {i} at {p}: {own} but never picked"
+                );
             }
             let sum: f32 = pmf.iter().sum();
             assert!(sum <= 1.0 + 1e-5 && sum > 0.95, "at {p}: {sum}");
@@ -269,7 +307,11 @@ mod tests {
                 counts[i] += 1;
             }
             let lost = none as f32 / n as f32;
-            assert!((lost - (1.0 - sum)).abs() < 1e-4, "at {p}: {lost} vs {}", 1.0 - sum);
+            assert!(
+                (lost - (1.0 - sum)).abs() < 1e-4,
+                "at {p}: {lost} vs {}",
+                1.0 - sum
+            );
             // Stratified numbers: far tighter than a chi-square's bound,
             // which holds too.
             let chi2: f64 = counts
@@ -295,9 +337,17 @@ mod tests {
         let members: Vec<usize> = (0..lights.len()).collect();
         let tree = LightTree::new(&lights, &members).unwrap();
         let (o, d) = (Vec3::new(-10.0, 50.0, 50.0), Vec3::X);
-        let imp = |b: &LightBounds| b.segment_importance(o, d, 0.0, 120.0);
-        let pmf: Vec<f32> = (0..lights.len()).map(|i| tree.probability(imp, i)).collect();
-        assert!((pmf.iter().sum::<f32>() - 1.0).abs() < 1e-5, "no light faces away from a segment");
+        let imp = |b: &LightBounds| {
+            let s = b.segment_importance(o, d, 0.0, 120.0);
+            (s, s)
+        };
+        let pmf: Vec<f32> = (0..lights.len())
+            .map(|i| tree.probability(imp, i))
+            .collect();
+        assert!(
+            (pmf.iter().sum::<f32>() - 1.0).abs() < 1e-5,
+            "no light faces away from a segment"
+        );
         let n = 200_000;
         let mut counts = vec![0u32; lights.len()];
         for k in 0..n {
@@ -307,7 +357,10 @@ mod tests {
         }
         for (i, (&c, &q)) in counts.iter().zip(&pmf).enumerate() {
             let f = c as f32 / n as f32;
-            assert!((f - q).abs() < 3.0 / n as f32 + 1e-5, "light {i}: {f} vs {q}");
+            assert!(
+                (f - q).abs() < 3.0 / n as f32 + 1e-5,
+                "light {i}: {f} vs {q}"
+            );
         }
     }
 
@@ -321,8 +374,10 @@ mod tests {
         let depth = tree.trails.iter().flatten().map(|t| t.depth).max().unwrap();
         assert_eq!(depth, 14);
         let p = Vec3::new(20.0, 70.0, 30.0);
-        let imp = |b: &LightBounds| b.importance(p);
-        let sum: f64 = (0..lights.len()).map(|i| tree.probability(imp, i) as f64).sum();
+        let imp = |b: &LightBounds| b.importance_range(p);
+        let sum: f64 = (0..lights.len())
+            .map(|i| tree.probability(imp, i) as f64)
+            .sum();
         assert!(sum <= 1.0 + 1e-4 && sum > 0.99, "{sum}");
     }
 }

@@ -120,7 +120,7 @@ impl ManyLights {
         }
         match &self.tree {
             Some(tree) if tree.holds(i) => {
-                let own = |b: &LightBounds| b.importance(at);
+                let own = |b: &LightBounds| b.importance_range(at);
                 self.share(self.tree_weight(at), total) * tree.probability(own, i)
             }
             _ => 0.0,
@@ -145,13 +145,16 @@ impl ManyLights {
         }
         let Some(tree) = &self.tree else {
             // Rounding left the sum a little below one.
-            return self.infinite.last().map(|&(i, w)| (i, self.share(w, total)));
+            return self
+                .infinite
+                .last()
+                .map(|&(i, w)| (i, self.share(w, total)));
         };
         let p = self.share(self.tree_weight(at), total);
         // The rest of the interval, rescaled to [0, 1) for the tree.
         let start = end;
         let u = ((u - start) / p).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-        let own = |b: &LightBounds| b.importance(at);
+        let own = |b: &LightBounds| b.importance_range(at);
         tree.pick(own, u).map(|(i, q)| (i, p * q))
     }
 }

@@ -42,8 +42,8 @@ use crate::light::GroupRadiance;
 use crate::light::Lights;
 use crate::ray::Ray;
 use crate::sampling::{Rng, SampleStream};
-use mis::Strategies;
 use light_choice::{LightChoice, LightSampler};
+use mis::Strategies;
 
 settings_enum! {
     /// Which integrator renders the image.

@@ -130,7 +130,7 @@ impl<'a, M: Media> PathTracer<'a, M> {
         };
         let surfaces = of(Light::is_surface);
         let points = of(|l| l.point_centre().is_some());
-        let point_pick = PointPick::new(&lights, &points);
+        let point_pick = PointPick::new(&lights, &points, false);
         let equiangular =
             !points.is_empty() && DistanceSampling::default().samples_equiangular(medium);
         // The first of the brightest, where several are alike.
@@ -206,9 +206,12 @@ impl<'a, M: Media> PathTracer<'a, M> {
     }
 
     /// Samples every light at each vertex, or one ([`LightSampling`]).
+    /// (`uniform` picks the equi-angular sample's light uniformly too.)
     pub fn with_light_sampling(self, light_sampling: LightSampling) -> Self {
+        let uniform = light_sampling == LightSampling::Uniform;
         Self {
             sampler: LightSampler::new(&self.lights, light_sampling),
+            point_pick: PointPick::new(&self.lights, &self.points, uniform),
             ..self
         }
     }

@@ -24,22 +24,22 @@
 //! any weights; these only decide the noise.
 //!
 //! One light per segment takes the equi-angular sample, picked in
-//! proportion to its unoccluded single scattering along the span, `I (theta_b
-//! - theta_a) / h` ([`PointPick`]): among a few lights, each weighed so;
-//! among many, by a light tree weighing its nodes by the same integral
-//! along the segment (Cycles' light tree for volume segments).
+//! proportion to its unoccluded single scattering along the span,
+//! `I (theta_b - theta_a) / h` ([`PointPick`]): among a few lights, each
+//! weighed so; among many, by a light tree weighing its nodes by the same
+//! integral along the segment (Cycles' light tree for volume segments).
 
 use glam::Vec3;
 
+use super::light_tree::LightTree;
+use super::mis::Strategies;
 use super::path::PathTracer;
 use super::path_state::{Arrival, Path, Vertex};
-use crate::counters::Counters;
-use super::light_tree::LightTree;
 use super::per_light::MAX_PICKED_LIGHTS;
+use crate::counters::Counters;
 use crate::light::{LightBounds, Lights};
 use crate::medium::Media;
 use crate::ray::Ray;
-use super::mis::Strategies;
 use crate::sampling::SampleStream;
 use crate::spectrum::Spectrum;
 use crate::tracking::transmittance;
@@ -133,11 +133,18 @@ pub(crate) enum PointPick {
     Few(Vec<(usize, Vec3, f32)>),
     /// Among many: a light tree over them.
     Many(LightTree),
+    /// Uniformly (the baseline the others are measured against): the
+    /// lights' indices.
+    Uniform(Vec<usize>),
 }
 
 impl PointPick {
-    /// The pick among the lights of `lights` at the indices `points`.
-    pub fn new(lights: &Lights, points: &[usize]) -> Self {
+    /// The pick among the lights of `lights` at the indices `points`
+    /// (`uniform`: each alike).
+    pub fn new(lights: &Lights, points: &[usize], uniform: bool) -> Self {
+        if uniform {
+            return Self::Uniform(points.to_vec());
+        }
         if points.len() > MAX_PICKED_LIGHTS {
             if let Some(tree) = LightTree::new(lights, points) {
                 return Self::Many(tree);
@@ -190,8 +197,17 @@ impl PointPick {
                 }
                 chosen.map(|(i, ea, w)| (i, ea, w / total))
             }
+            Self::Uniform(points) => {
+                let k = ((u * points.len() as f32) as usize).min(points.len().checked_sub(1)?);
+                let i = points[k];
+                let ea = EquiAngular::new(ray, lights.get(i).point_centre()?, t0, t1)?;
+                Some((i, ea, 1.0 / points.len() as f32))
+            }
             Self::Many(tree) => {
-                let reach = |b: &LightBounds| b.segment_importance(ray.origin, ray.dir, t0, t1);
+                let reach = |b: &LightBounds| {
+                    let r = b.segment_importance(ray.origin, ray.dir, t0, t1);
+                    (r, r)
+                };
                 let (i, q) = tree.pick(reach, u)?;
                 let ea = EquiAngular::new(ray, lights.get(i).point_centre()?, t0, t1)?;
                 Some((i, ea, q))

@@ -18,13 +18,13 @@
 
 use glam::Vec3;
 
+use super::mis::Strategies;
 use super::path::PathTracer;
 use super::path_state::{Escape, Path};
 use crate::counters::Counters;
 use crate::light::LightHit;
 use crate::medium::Media;
 use crate::ray::Ray;
-use super::mis::Strategies;
 use crate::sampling::{Draw, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::tracking::{sample_free_flight, FreeFlight};
@@ -129,11 +129,9 @@ impl<M: Media> PathTracer<'_, M> {
         }
         let weight = match &path.escape {
             Escape::Full => 1.0,
-            Escape::Mis(pdf, choice) => {
-                Strategies::drawn_with(*pdf)
+            Escape::Mis(pdf, choice) => Strategies::drawn_with(*pdf)
                 .or(self.sampler.probability(choice, h.light) * h.pdf)
-                .weight()
-            }
+                .weight(),
         };
         let e = path.beta * h.radiance * weight;
         path.add_to_group(e, self.lights.group(h.light), self.light_groups);

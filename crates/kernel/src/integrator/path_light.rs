@@ -6,13 +6,13 @@
 use glam::Vec3;
 
 use super::light_choice::LightChoice;
+use super::mis::Strategies;
 use super::path::PathTracer;
 use super::path_state::Vertex;
 use super::LightParts;
 use crate::counters::Counters;
 use crate::light::{Light, LightSample};
 use crate::medium::Media;
-use super::mis::Strategies;
 use crate::sampling::{Draw, SampleStream};
 use crate::spectrum::Spectrum;
 use crate::tracking::transmittance;
@@ -109,11 +109,11 @@ impl<M: Media> PathTracer<'_, M> {
     /// A direction toward `light` at `v`: drawn from the light itself,
     /// except for a light the same from every direction (a constant sky)
     /// at a vertex without MIS (the last one a path may scatter at), where
-    /// it is drawn from the phase function, the importance sampling of `f
-    /// * L` for any constant `L`. There nothing weighs the draw against
-    /// another strategy, and a sky sampled uniformly against a narrow
-    /// phase lobe (Mie scattering by cloud droplets) is a heavy-tailed
-    /// estimate that a light pick's small probability then multiplies into
+    /// it is drawn from the phase function, the importance sampling of
+    /// `f L` for any constant `L`. There nothing weighs the draw against
+    /// another strategy, and a sky sampled uniformly against a narrow phase
+    /// lobe (Mie scattering by cloud droplets) is a heavy-tailed estimate
+    /// that a light pick's small probability then multiplies into
     /// fireflies.
     #[inline]
     fn sample_toward(&self, v: &Vertex, light: &Light, u1: f32, u2: f32) -> LightSample {

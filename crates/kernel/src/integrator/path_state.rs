@@ -8,10 +8,10 @@
 use glam::Vec3;
 
 use super::light_choice::LightChoice;
+use super::mis::Strategies;
 use super::{LightParts, Sample};
 use crate::phase::Phase;
 use crate::ray::Ray;
-use super::mis::Strategies;
 
 /// What the lights at infinity a ray escapes to add.
 #[derive(Clone, Copy, Debug)]

@@ -43,13 +43,13 @@
 use glam::Vec3;
 
 use super::light_choice::PerLight;
+use super::mis::Strategies;
 use super::path::PathTracer;
 use super::path_state::{At, Path};
 use crate::counters::Counters;
 use crate::medium::Media;
 use crate::phase::Phase;
 use crate::ray::Ray;
-use super::mis::Strategies;
 use crate::sampling::SampleStream;
 use crate::spectrum::Spectrum;
 use crate::tracking::{sample_free_flight, transmittance, FreeFlight};

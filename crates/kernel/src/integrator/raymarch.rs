@@ -81,7 +81,12 @@ impl<'a, M: Media> RayMarcher<'a, M> {
                 None => {
                     light.count_sample(c);
                     let w = phase.sample(dir, u1, u2).0;
-                    (w, 1.0, light.escaped(w).map_or(Vec3::ZERO, |e| e.0), f32::INFINITY)
+                    (
+                        w,
+                        1.0,
+                        light.escaped(w).map_or(Vec3::ZERO, |e| e.0),
+                        f32::INFINITY,
+                    )
                 }
             };
             let tr: E = marched_transmittance(

@@ -86,8 +86,10 @@ impl LightBounds {
         if other.phi <= 0.0 {
             return *self;
         }
-        let (axis, cos_theta_o) =
-            cone_union((self.axis, self.cos_theta_o), (other.axis, other.cos_theta_o));
+        let (axis, cos_theta_o) = cone_union(
+            (self.axis, self.cos_theta_o),
+            (other.axis, other.cos_theta_o),
+        );
         Self {
             min: self.min.min(other.min),
             max: self.max.max(other.max),
@@ -138,6 +140,27 @@ impl LightBounds {
         let r = self.radius();
         let d2 = true_d2.max(r * r).max(MIN_DISTANCE2);
         self.phi * cos_p / d2
+    }
+
+    /// The cluster's least and greatest importance for a point at `p`,
+    /// over where in the box its light may come from: `phi cos theta' /
+    /// d^2` with `d` the distance to the box's farthest corner and to its
+    /// nearest point (0 inside, floored; Cycles' light tree weighs a
+    /// child by both, so a cluster about `p` is not lost behind its size).
+    #[inline]
+    pub fn importance_range(&self, p: Vec3) -> (f32, f32) {
+        if self.phi <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let true_d2 = (p - self.centre()).length_squared();
+        let Some(cos_p) = self.cos_theta_prime(p, true_d2) else {
+            return (0.0, 0.0);
+        };
+        let near = (self.min - p).max(p - self.max).max(Vec3::ZERO);
+        let far = (p - self.min).abs().max((self.max - p).abs());
+        let least = self.phi * cos_p / far.length_squared().max(MIN_DISTANCE2);
+        let most = self.phi * cos_p / near.length_squared().max(MIN_DISTANCE2);
+        (least, most)
     }
 
     /// The cluster's importance for the ray segment from `o` along unit
@@ -209,9 +232,8 @@ mod tests {
     /// starve a light), and a flat light has none behind it.
     #[test]
     fn a_cluster_bounds_its_lights() {
-        let area = |c: Vec3, n: Vec3| {
-            AreaLight::new(AreaShape::Rect, c, Vec3::X, Vec3::Y, n, Vec3::ONE)
-        };
+        let area =
+            |c: Vec3, n: Vec3| AreaLight::new(AreaShape::Rect, c, Vec3::X, Vec3::Y, n, Vec3::ONE);
         let lights = [
             LightBounds::ball(Vec3::ZERO, 0.0, 2.0),
             LightBounds::ball(Vec3::new(4.0, 1.0, 0.0), 0.5, 1.0),

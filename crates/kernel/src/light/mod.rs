@@ -20,9 +20,9 @@ mod spherical_rect;
 
 pub use area::{AreaLight, AreaShape};
 pub use bounds::LightBounds;
-pub use interface::{LightHit, Whence};
 pub use distant::Sun;
 pub use dome::Environment;
+pub use interface::{LightHit, Whence};
 pub use limits::{shown, MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE};
 pub use sphere::{SphereLight, Spot};
 
