@@ -12,6 +12,7 @@
 mod area;
 mod distant;
 mod dome;
+mod facing_disk;
 mod limits;
 mod sphere;
 mod spherical_rect;
