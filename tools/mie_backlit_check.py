@@ -23,8 +23,16 @@ Cycles in f32 through its `fast_expf` (kernel/closure/volume_util.h,
 phase function's normalisation, `<p>` at the check's angle for each (and
 evaluated as each renderer does it in f32), and the slab's L ratio.
 
+With `--render cirrus` (the cirrus module importable) or `--render
+cycles` (PyPI's bpy 5.2.3, as target/venv-blender has) it also renders
+the slab, `data/tile_box.vdb` (128 voxels of density 0.5) at optical
+depth `tau`, seen along its normal from 20000 units with a 0.05 degree
+field of view (rays within 0.025 degrees of the normal), single
+scattering, and prints the image mean against the closed form.
+
 Usage: python3 tools/mie_backlit_check.py [--diameter 20] [--theta 3]
-       [--angle 0.526] [--tau 2]   (needs numpy)
+       [--angle 0.526] [--tau 2] [--render cirrus|cycles] [--spp 1024]
+       (needs numpy)
 """
 
 from __future__ import annotations
@@ -146,12 +154,124 @@ def slab(mean_phase: float, theta0: float, tau: float, albedo: float = 1.0) -> f
     return albedo * mean_phase * mu0 / (1.0 - mu0) * (math.exp(-tau) - math.exp(-tau / mu0))
 
 
+REPO = __import__("pathlib").Path(__file__).resolve().parents[1]
+BOX = REPO / "data" / "tile_box.vdb"
+BOX_SIDE, BOX_DENSITY = 128.0, 0.5
+
+
+def render_cirrus(a, seeds=(1, 2, 3, 4)) -> list[float]:
+    """The slab's image mean by cirrus, one per seed."""
+    import cirrus
+
+    th = math.radians(a.theta)
+    means = []
+    for seed in seeds:
+        img, _ = cirrus.render({
+            "render": {"spp": a.spp, "seed": seed, "max_depth": 1},
+            "camera": {"res": "64x64", "from": [64.0, 64.0, 20000.0], "to": [64.0, 64.0, 64.0],
+                       "fov": 0.05},
+            "sun": {"direction": [math.sin(th), 0.0, math.cos(th)], "irradiance": [1.0] * 3,
+                    "angle": a.angle},
+            "environment": {"radiance": [0.0] * 3},
+            "volume": [{"file": str(BOX), "albedo": 1.0, "phase": "mie",
+                        "droplet_diameter": a.diameter,
+                        "density_scale": a.tau / (BOX_DENSITY * BOX_SIDE)}],
+        })
+        means.append(float(img[..., :3].astype(np.float64).mean()))
+    return means
+
+
+def render_cycles(a, seeds=(1, 2)) -> list[float]:
+    """The slab's image mean by Cycles (Volume Scatter, Mie phase, the
+    density attribute scaled to `tau`), one per seed."""
+    import os
+    import tempfile
+
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp())
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    vol = bpy.data.volumes.new("box")
+    vol.filepath = str(BOX)
+    vol.render.precision, vol.render.clipping = "FULL", 0.0
+    vol.grids.load()
+    obj = bpy.data.objects.new("Box", vol)
+    scene.collection.objects.link(obj)
+    mat = bpy.data.materials.new("Fog")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    sc = nt.nodes.new("ShaderNodeVolumeScatter")
+    sc.phase = "MIE"
+    sc.inputs["Diameter"].default_value = a.diameter
+    sc.inputs["Color"].default_value = (1, 1, 1, 1)
+    attr = nt.nodes.new("ShaderNodeAttribute")
+    attr.attribute_name = "density"
+    mul = nt.nodes.new("ShaderNodeMath")
+    mul.operation = "MULTIPLY"
+    mul.inputs[1].default_value = a.tau / (BOX_DENSITY * BOX_SIDE)
+    nt.links.new(attr.outputs["Fac"], mul.inputs[0])
+    nt.links.new(mul.outputs["Value"], sc.inputs["Density"])
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    nt.links.new(sc.outputs["Volume"], out.inputs["Volume"])
+    vol.materials.append(mat)
+    cam_data = bpy.data.cameras.new("Cam")
+    cam_data.sensor_fit, cam_data.angle_y = "VERTICAL", math.radians(0.05)
+    cam_data.clip_start, cam_data.clip_end = 1.0, 1e6
+    cam = bpy.data.objects.new("Cam", cam_data)
+    cam.location = (63.5, 63.5, 20000.0)  # Blender's box: voxel centres at 0..127
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    sun_data = bpy.data.lights.new("Sun", "SUN")
+    sun_data.energy, sun_data.angle, sun_data.normalize = 1.0, math.radians(a.angle), True
+    sun = bpy.data.objects.new("Sun", sun_data)
+    sun.rotation_euler = (0.0, math.pi - math.radians(a.theta), 0.0)  # travelling up, tilted
+    scene.collection.objects.link(sun)
+    world = bpy.data.worlds.new("W")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+    r = scene.render
+    r.resolution_x = r.resolution_y = 64
+    r.resolution_percentage = 100
+    r.use_compositing = r.use_sequencer = False
+    r.film_transparent = False
+    r.image_settings.file_format, r.image_settings.color_depth = "OPEN_EXR", "32"
+    r.image_settings.color_mode = "RGBA"
+    scene.view_settings.view_transform, scene.view_settings.look = "Standard", "None"
+    scene.view_settings.exposure = 0.0
+    r.engine = "CYCLES"
+    cy = scene.cycles
+    cy.device, cy.samples = "CPU", a.spp
+    cy.use_adaptive_sampling = cy.use_denoising = cy.use_guiding = False
+    cy.sample_clamp_direct = cy.sample_clamp_indirect = 0.0
+    cy.light_sampling_threshold = 0.0
+    cy.volume_biased = False
+    cy.pixel_filter_type, cy.filter_width = "BOX", 1.0
+    cy.sampling_pattern, cy.film_exposure = "TABULATED_SOBOL", 1.0
+    cy.max_bounces, cy.volume_bounces = 1, 0  # single scattering
+    means = []
+    for seed in seeds:
+        cy.seed = seed
+        path = os.path.join(tempfile.mkdtemp(), "slab.exr")
+        r.filepath = path
+        bpy.ops.render.render(write_still=True)
+        img = bpy.data.images.load(path, check_existing=False)
+        px = np.array(img.pixels[:], dtype=np.float64).reshape(64, 64, 4)
+        bpy.data.images.remove(img)
+        means.append(float(px[..., :3].mean()))
+    return means
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--diameter", type=float, default=20.0, help="droplet diameter, um")
     ap.add_argument("--theta", type=float, default=3.0, help="sun off the view axis, degrees")
     ap.add_argument("--angle", type=float, default=0.526, help="sun's angular diameter, degrees")
     ap.add_argument("--tau", type=float, default=2.0, help="slab optical depth")
+    ap.add_argument("--render", choices=["cirrus", "cycles"], help="render the slab as well")
+    ap.add_argument("--spp", type=int, default=1024, help="samples per pixel of --render")
     a = ap.parse_args()
     theta0, angle = math.radians(a.theta), math.radians(a.angle)
     ours, theirs = fit_f64(a.diameter), fit_cycles(a.diameter)
@@ -178,6 +298,13 @@ def main() -> None:
           f" ratio cirrus/Cycles {l_ours / l_theirs:.5f}")
     l_delta = slab(centre, theta0, a.tau)
     print(f"  a sun taken as a delta at its centre: ratio to the disc's {l_delta / l_ours:.5f}")
+    if a.render:
+        means = (render_cirrus if a.render == "cirrus" else render_cycles)(a)
+        m = float(np.mean(means))
+        err = float(np.std(means, ddof=1) / math.sqrt(len(means)))
+        print(f"{a.render} render, {a.spp} spp x {len(means)} seeds: {m:.6f} +- {err:.6f}"
+              f" (seeds {', '.join(f'{x:.6f}' for x in means)}),"
+              f" over the closed form {m / l_ours:.5f} +- {err / l_ours:.5f}")
 
 
 if __name__ == "__main__":
