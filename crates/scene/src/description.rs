@@ -310,7 +310,8 @@ declare_settings! {
         /// Whether a sphere or spot light lights each point from the disc
         /// of its radius through its centre facing the point rather than
         /// from its ball (default false: UsdLux's sphere; Blender's Soft
-        /// Falloff, which its point and spot lamps have on by default).
+        /// Falloff, on by default for its point and spot lamps, which the
+        /// add-on passes).
         soft_falloff: Option<bool>;
         /// A dome's lat-long HDR map (EXR, relative to the scene file).
         map: Option<PathBuf>;
