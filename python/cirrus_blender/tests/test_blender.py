@@ -304,10 +304,10 @@ def fog_scene():
 def test_each_lamp_alone_lights_a_box_of_fog_as_cycles_does(addon, tmp_path, kind):
     """A box of homogeneous fog (`tile_box.vdb`, 0.64 mean free paths
     across: equi-angular sampling on under `auto`) lit by one lamp of each
-    kind, the sun and sky off. Points and spots sit above the fog: inside
-    it and in view, Cycles 5.2 shows a spot lamp's own disc to camera rays
-    (its `visible_camera` notwithstanding), which cirrus does not; a point
-    lamp of this size inside the fog agrees (z +3.1, BENCHMARKS.md)."""
+    kind, the sun and sky off. Points and spots sit above the fog; lamps
+    inside fog (where the fog within a spot's ball is lit unshaped, as in
+    Cycles) are tested by
+    `test_lamps_inside_and_outside_fog_with_and_without_soft_falloff`."""
     import mathutils
 
     scene, centre, size = fog_scene()
