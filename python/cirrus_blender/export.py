@@ -27,9 +27,11 @@ What is mapped:
   named by its object (its light-group layer; camera rays see a lamp's
   surface where its object is visible to the camera), and area lamps (square,
   rectangle, disk, ellipse; Cycles' radiance `P c / (pi A)`, the size
-  scaled by the object, emitting along -Z); Cycles' soft falloff (on by
-  default) changes a lamp's light only near its surface, where cirrus's
-  ball is uniform; the world's Background
+  scaled by the object, emitting along -Z); a point or spot lamp's Soft
+  Falloff (`use_soft_falloff`, on by default) maps to `soft_falloff`:
+  Cycles then lights each point from the disc of the lamp's radius
+  through its centre facing the point, which cirrus does alike; the
+  world's Background
   colour or an equirectangular Environment Texture, and the scene camera
   (its matrix, field of view and clip range);
 - motion blur: the shutter, and the volume's velocity grid.
@@ -264,11 +266,13 @@ class Export:
         intensity = [float(c) * float(light.energy) / (4.0 * math.pi) for c in light.color]
         entry: dict = {"name": obj.name, "position": list(position)}
         if radius > 0.0:
-            # A ball of radiance I / (pi r^2) sends I; camera rays see it
-            # where the lamp's object is visible to the camera, as in Cycles.
+            # A ball (or, with Soft Falloff, a facing disc) of radiance
+            # I / (pi r^2) sends I; camera rays see it where the lamp's
+            # object is visible to the camera, as in Cycles.
             entry.update({"type": "sphere", "radius": radius,
                           "color": [i / (math.pi * radius * radius) for i in intensity],
-                          "visible_to_camera": bool(obj.visible_camera)})
+                          "visible_to_camera": bool(obj.visible_camera),
+                          "soft_falloff": bool(getattr(light, "use_soft_falloff", True))})
         else:
             entry.update({"type": "point", "color": intensity})
         if light.type == "SPOT":

@@ -166,6 +166,35 @@ def test_a_dict_scene_equals_its_toml_file(tmp_path):
     assert from_file[..., 3].max() > 0.5, "the cloud is in view"
 
 
+def test_soft_falloff_passes_from_a_dict_and_dims_the_cloud_near_a_lamp():
+    """A ball of light of radius 30 inside the cloud and far above it:
+    with `soft_falloff` (a disc through the centre facing each point,
+    Blender's default) the lamp inside lights the cloud far less (its
+    light starts 30 voxels deeper in the cloud), the lamp far above
+    alike; a light table that names the key for a point light is refused
+    by name."""
+
+    def mean(light):
+        scene = {
+            "render": {"spp": 8, "seed": 1},
+            "camera": {"res": "16x16"},
+            "volume": [{"file": str(CLOUD), "albedo": 0.9, "g": 0.3}],
+            "light": [light],
+        }
+        return cirrus.render(scene)[0][..., :3].mean()
+
+    for centre, near in (([150.0, 80.0, 100.0], True), ([150.0, 300.0, 100.0], False)):
+        lamp = {"type": "sphere", "position": centre, "radius": 30.0, "intensity": 1.0}
+        ball, disc = mean(lamp), mean({**lamp, "soft_falloff": True})
+        assert ball > 0.0 and np.isfinite(disc), (ball, disc)
+        if near:
+            assert disc < 0.01 * ball, (ball, disc)
+        else:
+            assert abs(disc / ball - 1.0) < 0.05, (ball, disc)
+    with pytest.raises(ValueError, match="`soft_falloff` does not apply to a point light"):
+        mean({"type": "point", "position": [0.0, 0.0, 0.0], "soft_falloff": True})
+
+
 def test_one_and_two_threads_give_the_same_image():
     one, _ = cirrus.render(CLOUD, threads=1, **SMALL)
     two, _ = cirrus.render(CLOUD, threads=2, **SMALL)

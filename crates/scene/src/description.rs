@@ -307,6 +307,12 @@ declare_settings! {
         /// (default false, as Cycles' and Arnold's lamps: the light shows
         /// in the media it lights; scattered rays always meet it).
         visible_to_camera: Option<bool>;
+        /// Whether a sphere or spot light lights each point from the disc
+        /// of its radius through its centre facing the point rather than
+        /// from its ball (default false: UsdLux's sphere; Blender's Soft
+        /// Falloff, on by default for its point and spot lamps, which the
+        /// add-on passes).
+        soft_falloff: Option<bool>;
         /// A dome's lat-long HDR map (EXR, relative to the scene file).
         map: Option<PathBuf>;
         /// A dome map's rotation about +Y in degrees.

@@ -26,7 +26,13 @@ const KINDS: [&str; 8] = [
 fn keys_of(kind: &str) -> &'static [&'static str] {
     match kind {
         "distant" => &["direction", "angle"],
-        "sphere" => &["position", "radius", "normalize", "visible_to_camera"],
+        "sphere" => &[
+            "position",
+            "radius",
+            "normalize",
+            "visible_to_camera",
+            "soft_falloff",
+        ],
         "point" => &["position"],
         "spot" => &[
             "position",
@@ -36,6 +42,7 @@ fn keys_of(kind: &str) -> &'static [&'static str] {
             "cone_angle",
             "cone_softness",
             "visible_to_camera",
+            "soft_falloff",
         ],
         "rect" => &[
             "position",
@@ -85,6 +92,7 @@ impl LightSpec {
             ("cone_softness", self.cone_softness.is_some()),
             ("map", self.map.is_some()),
             ("visible_to_camera", self.visible_to_camera.is_some()),
+            ("soft_falloff", self.soft_falloff.is_some()),
             ("rotation", self.rotation.is_some()),
         ];
         present.iter().filter(|p| p.1).map(|p| p.0).collect()

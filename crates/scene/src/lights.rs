@@ -99,7 +99,8 @@ impl LightSpec {
                 };
                 let r = self.radius.unwrap_or(default_radius);
                 let light = SphereLight::new(v3(self.position), r, intensity(strength, r, self))
-                    .seen_by_camera(self.visible_to_camera.unwrap_or(false));
+                    .seen_by_camera(self.visible_to_camera.unwrap_or(false))
+                    .with_soft_falloff(self.soft_falloff.unwrap_or(false));
                 match kind {
                     "spot" => light.with_spot(Spot::new(
                         v3(self.direction),

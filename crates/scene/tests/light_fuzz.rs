@@ -53,7 +53,7 @@ fn pick<'a>(rng: &mut SplitMix64, from: &[&'a str]) -> &'a str {
 fn takes(kind: &str) -> &'static [&'static str] {
     match kind {
         "distant" => &["direction", "angle"],
-        "sphere" => &["position", "radius", "normalize"],
+        "sphere" => &["position", "radius", "normalize", "soft_falloff"],
         "point" => &["position"],
         "spot" => &[
             "position",
@@ -62,6 +62,7 @@ fn takes(kind: &str) -> &'static [&'static str] {
             "normalize",
             "cone_angle",
             "cone_softness",
+            "soft_falloff",
         ],
         "rect" => &["position", "direction", "width", "height", "normalize"],
         "disk" => &["position", "direction", "radius", "normalize"],
@@ -101,6 +102,7 @@ fn light_table(rng: &mut SplitMix64) -> String {
         format!("color = {}", vector(rng, ["1", "0.9", "0.8"])),
         format!("radius = {}", number(rng, "10")),
         format!("normalize = {}", rng.below(2) == 0),
+        format!("soft_falloff = {}", rng.below(2) == 0),
         format!("name = \"{}\"", pick(rng, &NAMES)),
     ];
     match kind {

@@ -45,6 +45,7 @@ fn a_sphere_light_sends_its_radiance_times_its_projected_area() {
         panic!("{:?}", lights[0])
     };
     assert!(s.camera_visible());
+    assert!(!s.soft_falloff(), "a ball by default, as UsdLux's sphere");
     assert!(
         (s.intensity() - Vec3::new(1.0, 0.5, 0.25))
             .abs()
@@ -68,6 +69,19 @@ fn a_sphere_light_sends_its_radiance_times_its_projected_area() {
     };
     assert!(s.is_point());
     assert_eq!(s.intensity(), Vec3::splat(3.0));
+    // Soft falloff on a sphere and a spot; refused where it has no meaning.
+    for (kind, axis) in [
+        ("sphere", ""),
+        ("spot", "direction = [0, -1, 0]\ncone_angle = 30\n"),
+    ] {
+        let lights = lights_of(&format!(
+            "[[light]]\ntype = \"{kind}\"\nposition = [0, 0, 0]\n{axis}radius = 0.5\nsoft_falloff = true\n"
+        ));
+        let Light::Sphere(s) = &lights[0] else {
+            panic!()
+        };
+        assert!(s.soft_falloff(), "{kind}");
+    }
 }
 
 #[test]
@@ -204,6 +218,10 @@ fn bad_lights_are_errors_naming_the_file_and_the_light() {
             "`visible_to_camera` does not apply to a point light",
         ),
         ("type = \"distant\"\ndirection = [0, -1, 0]\nradius = 1", "`radius` does not apply to a distant light"),
+        (
+            "type = \"point\"\nposition = [0, 0, 0]\nsoft_falloff = true",
+            "`soft_falloff` does not apply to a point light",
+        ),
         ("type = \"point\"\nposition = [0, 0, 0]\ncolor = [1, -1, 1]", "`color` is negative"),
     ] {
         let e = error_of(&format!("{lamp}{body}\n"));

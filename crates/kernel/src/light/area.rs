@@ -295,7 +295,7 @@ impl AreaLight {
 
 /// Shirley and Chiu's concentric map of `[0, 1)^2` onto the unit disc.
 #[inline]
-fn concentric_disk(u1: f32, u2: f32) -> Vec2 {
+pub(super) fn concentric_disk(u1: f32, u2: f32) -> Vec2 {
     let (a, b) = (2.0 * u1 - 1.0, 2.0 * u2 - 1.0);
     if a == 0.0 && b == 0.0 {
         return Vec2::ZERO;

@@ -13,6 +13,7 @@ mod area;
 mod bounds;
 mod distant;
 mod dome;
+mod facing_disk;
 mod interface;
 mod limits;
 mod sphere;

@@ -20,11 +20,18 @@
 //! leaves the ball. Whether a direction brings light thus depends only on
 //! where it starts (outside: if it meets the ball; inside: always), which
 //! sampling and rays that meet the ball share, so the two weigh alike.
+//! Inside a spot's ball the cone does not apply (as in Cycles: every
+//! direction brings the ball's full radiance).
+//!
+//! With soft falloff (Blender's Soft Falloff, `facing_disk.rs`) the light
+//! is instead the disc of the same radius and radiance through its centre
+//! facing the lit point, sampled and met with Cycles' densities.
 
 use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use super::facing_disk::FacingDisk;
 use super::LightSample;
 use crate::sampling::{uniform_cone, uniform_sphere, UNIFORM_SPHERE_PDF};
 
@@ -88,6 +95,9 @@ pub struct SphereLight {
     /// Cycles' lamps: the light shows in the media it lights, not as a
     /// bright disc in the image); scattered rays always meet it.
     camera_visible: bool,
+    /// Whether it lights a point from the disc through its centre facing
+    /// the point rather than from its ball (`facing_disk.rs`).
+    soft_falloff: bool,
 }
 
 impl SphereLight {
@@ -101,7 +111,22 @@ impl SphereLight {
             intensity,
             spot: None,
             camera_visible: false,
+            soft_falloff: false,
         }
+    }
+
+    /// The same light, lighting each point from the disc through its
+    /// centre facing the point where `soft` (Blender's Soft Falloff).
+    pub fn with_soft_falloff(self, soft: bool) -> Self {
+        Self {
+            soft_falloff: soft,
+            ..self
+        }
+    }
+
+    /// Whether it lights from a facing disc ([`Self::with_soft_falloff`]).
+    pub fn soft_falloff(&self) -> bool {
+        self.soft_falloff
     }
 
     /// The same light, seen by camera rays where `visible`.
@@ -180,7 +205,8 @@ impl SphereLight {
     /// Samples the light from `p`: a point's one direction, or a direction
     /// uniform in the cone the ball subtends with the distance to its near
     /// surface; from inside the ball, a direction uniform over the sphere
-    /// with the distance to where it leaves the ball.
+    /// with the distance to where it leaves the ball (and no spot cone);
+    /// with soft falloff, a point uniform on the disc facing `p`.
     #[inline]
     pub fn sample(&self, p: Vec3, u1: f32, u2: f32) -> LightSample {
         let to_centre = self.position - p;
@@ -195,11 +221,28 @@ impl SphereLight {
                 distance: d,
             };
         }
+        if self.soft_falloff {
+            let disk = FacingDisk::facing(p, self.position, self.radius);
+            return match disk.sample(p, u1, u2) {
+                Some((to_light, distance, pdf)) => LightSample {
+                    to_light,
+                    radiance: self.radiance() * self.falloff(-to_light),
+                    pdf: Some(pdf),
+                    distance,
+                },
+                None => LightSample {
+                    to_light: axis,
+                    radiance: Vec3::ZERO,
+                    pdf: Some(0.0),
+                    distance: 0.0,
+                },
+            };
+        }
         let Some(one_minus_cos) = self.cone(d2) else {
             let to_light = uniform_sphere(u1, u2);
             return LightSample {
                 to_light,
-                radiance: self.radiance() * self.falloff(-to_light),
+                radiance: self.radiance(),
                 pdf: Some(UNIFORM_SPHERE_PDF),
                 distance: self.exit_distance(to_centre, to_light),
             };
@@ -217,22 +260,29 @@ impl SphereLight {
     /// Where a ray from `p` along unit `dir` first meets the ball within
     /// `t_max` (its outside; from inside, where it leaves): the distance,
     /// the radiance it sees there and the density with which
-    /// [`Self::sample`] at `p` draws `dir`. `None` for a point or a miss.
+    /// [`Self::sample`] at `p` draws `dir`; with soft falloff, where it
+    /// meets the disc facing `p`. `None` for a point or a miss.
     #[inline]
     pub fn hit(&self, p: Vec3, dir: Vec3, t_max: f32) -> Option<(f32, Vec3, f32)> {
         if self.is_point() {
             return None;
         }
+        if self.soft_falloff {
+            let disk = FacingDisk::facing(p, self.position, self.radius);
+            let (t, pdf) = disk.hit(p, dir, t_max)?;
+            return Some((t, self.radiance() * self.falloff(-dir), pdf));
+        }
         let to_centre = self.position - p;
         let d2 = to_centre.length_squared();
-        let (t, pdf) = match self.cone(d2) {
+        let (t, pdf, falloff) = match self.cone(d2) {
             Some(one_minus_cos) => (
                 self.hit_distance(to_centre, dir)?,
                 1.0 / (2.0 * PI * one_minus_cos),
+                self.falloff(-dir),
             ),
-            None => (self.exit_distance(to_centre, dir), UNIFORM_SPHERE_PDF),
+            None => (self.exit_distance(to_centre, dir), UNIFORM_SPHERE_PDF, 1.0),
         };
-        (t < t_max).then(|| (t, self.radiance() * self.falloff(-dir), pdf))
+        (t < t_max).then(|| (t, self.radiance() * falloff, pdf))
     }
 
     /// The near root of the ray from the ball's outside (`to_centre` from
@@ -353,5 +403,54 @@ mod tests {
             l.sample(Vec3::new(5.0, 1.0, 0.0), 0.5, 0.5).radiance,
             Vec3::ZERO
         );
+    }
+
+    /// With soft falloff the light is the disc facing the point: the
+    /// irradiance-like integral of its radiance over the directions it
+    /// samples (the mean of `L / pdf`) is `2 pi L (1 - d / sqrt(d^2 +
+    /// r^2))` at distance `d`, inside the ball's radius too, and a ray
+    /// meets it where the sample lies.
+    #[test]
+    fn soft_falloff_lights_from_the_facing_disc() {
+        let (r, d) = (2.0f32, 0.5f32);
+        let l = SphereLight::new(Vec3::ZERO, r, Vec3::splat(PI * r * r)).with_soft_falloff(true);
+        assert_eq!(l.radiance(), Vec3::ONE);
+        let p = Vec3::new(d, 0.0, 0.0);
+        let n = 128;
+        let mut sum = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                let (u1, u2) = ((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let s = l.sample(p, u1, u2);
+                let pdf = s.pdf.unwrap();
+                if pdf > 0.0 {
+                    sum += (s.radiance.x / pdf) as f64;
+                    let (t, radiance, hit_pdf) = l.hit(p, s.to_light, f32::INFINITY).unwrap();
+                    assert!((t - s.distance).abs() < 1e-4 && radiance == s.radiance);
+                    assert!((hit_pdf / pdf - 1.0).abs() < 1e-3);
+                }
+            }
+        }
+        let exact = 2.0 * std::f64::consts::PI * (1.0 - 0.5 / (0.25f64 + 4.0).sqrt());
+        let mean = sum / (n * n) as f64;
+        assert!((mean / exact - 1.0).abs() < 2e-3, "{mean} {exact}");
+        // Rays away from the centre miss it: no point is inside a disc.
+        assert!(l.hit(p, Vec3::X, f32::INFINITY).is_none());
+    }
+
+    /// Inside a spot's ball every direction brings the ball's radiance,
+    /// the cone notwithstanding (Cycles' spot lamps); outside, the cone
+    /// shapes it.
+    #[test]
+    fn inside_a_spots_ball_the_cone_does_not_apply() {
+        let spot = Spot::new(-Vec3::Y, 20f32.to_radians(), 0.0);
+        let l = SphereLight::new(Vec3::ZERO, 1.0, Vec3::splat(PI)).with_spot(spot);
+        let inside = Vec3::new(0.0, 0.5, 0.0);
+        let s = l.sample(inside, 0.3, 0.7);
+        assert_eq!(s.radiance, Vec3::ONE);
+        let (_, radiance, _) = l.hit(inside, Vec3::X, f32::INFINITY).unwrap();
+        assert_eq!(radiance, Vec3::ONE);
+        let above = Vec3::new(0.0, 3.0, 0.0);
+        assert_eq!(l.sample(above, 0.3, 0.7).radiance, Vec3::ZERO);
     }
 }

@@ -15,7 +15,8 @@
 //! A sphere light's radiance is `intensity x 2^exposure x color`, over its
 //! area `4 pi r^2` where `normalize` is on; its radius is scaled by its
 //! world transform (the mean of the axes' scales). With `treatAsPoint` it
-//! is a point of the sphere's own intensity, `L pi r^2`. A spot's axis is
+//! is a point of the sphere's own intensity, `L pi r^2`. UsdLux has no
+//! soft falloff: a sphere light is its ball (`soft_falloff` off). A spot's axis is
 //! the light's -Z; `shaping:focus` and IES profiles are named in a warning
 //! and not applied.
 
