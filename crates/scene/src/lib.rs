@@ -48,6 +48,7 @@ pub mod frames;
 pub mod grids;
 pub mod info;
 mod light_checks;
+mod light_keys;
 pub mod lights;
 mod moving;
 mod output;
@@ -70,6 +71,7 @@ pub use denoise_tiles::merge_tiles;
 pub use description::OutputFlags;
 pub use description::SceneDescription;
 pub use error::{Error, ErrorKind, Result};
+pub use light_keys::LightKey;
 #[cfg(feature = "clap")]
 pub use flags::{settings_table, SceneFlags};
 pub use output::{has_extension, write_whole, Outputs};

@@ -21,7 +21,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 use cirrus_render::compositing::{DEFAULT_LIGHT_GROUPS, MAX_LIGHT_GROUPS};
-use cirrus_render::{AreaLight, AreaShape, Environment, Light, Lights, SphereLight, Spot, Sun};
+use cirrus_render::kernel::light::LightsOverShutter;
+use cirrus_render::{
+    AreaLight, AreaShape, Environment, IntegratorKind, Light, Lights, SphereLight, Spot, Sun,
+};
 use glam::Vec3;
 
 use crate::description::{LightSpec, SceneDescription};
@@ -278,15 +281,78 @@ pub fn lights(desc: &SceneDescription) -> Result<Lights> {
         };
         list.push((light.into(), index(DEFAULT_LIGHT_GROUPS[1])));
     }
+    let frame = desc.frame();
+    let first_table = list.len();
     for spec in &desc.lights {
         let group = if names.iter().any(|n| n == spec.group_name()) {
             spec.group_name()
         } else {
             kind_layer(spec)
         };
-        list.push((spec.light()?, index(group)));
+        list.push((spec.at(frame).light()?, index(group)));
     }
-    Ok(Lights::grouped(list, index(DEFAULT_LIGHT_GROUPS[2])).pruned())
+    let emission = index(DEFAULT_LIGHT_GROUPS[2]);
+    let shutter = over_shutter(desc, &list[first_table..])?;
+    let still = Lights::grouped(list.iter().cloned(), emission);
+    let shutter = shutter.and_then(|(open, close, tables)| {
+        let tables = tables
+            .into_iter()
+            .map(|table| {
+                let lights = list[..first_table].iter().cloned().chain(table);
+                Lights::grouped(lights, emission)
+            })
+            .collect();
+        LightsOverShutter::new(open, close, tables)
+    });
+    Ok(match shutter {
+        Some(s) => still.with_shutter(s),
+        None => still,
+    }
+    .pruned())
+}
+
+/// Times a moving light is tabulated at over the shutter: as many as a
+/// moving volume's transform (`moving.rs`).
+const SHUTTER_TABLES: usize = 65;
+
+/// The open and close times and, at each of [`SHUTTER_TABLES`] times
+/// over the shutter, the `[[light]]`s (`frame_lights`, as made at the
+/// frame, with their groups) where any changes while the shutter is
+/// open; lights that hold still are the frame's in every table.
+#[allow(clippy::type_complexity)]
+fn over_shutter(
+    desc: &SceneDescription,
+    frame_lights: &[(Light, u8)],
+) -> Result<Option<(f32, f32, Vec<Vec<(Light, u8)>>)>> {
+    let frame = desc.frame();
+    let [open, close] = desc.render.shutter();
+    let (t0, t1) = (frame + f64::from(open), frame + f64::from(close));
+    let moving: Vec<bool> = desc.lights.iter().map(|l| l.moves_within(t0, t1)).collect();
+    let Some(first) = moving.iter().position(|&m| m) else {
+        return Ok(None);
+    };
+    if desc.render.integrator() == IntegratorKind::RayMarch2Pass {
+        return Err(Error::input(format!(
+            "{} changes while the shutter is open: raymarch2pass caches the light at one time; \
+             render it with the path tracer or raymarch, or close the shutter",
+            desc.lights[first].label(first)
+        )));
+    }
+    let tables = (0..SHUTTER_TABLES)
+        .map(|k| {
+            let time = t0 + (t1 - t0) * k as f64 / (SHUTTER_TABLES - 1) as f64;
+            desc.lights
+                .iter()
+                .zip(&moving)
+                .zip(frame_lights)
+                .map(|((spec, &moves), (still, group))| match moves {
+                    true => Ok((spec.at(time).light()?, *group)),
+                    false => Ok((still.clone(), *group)),
+                })
+                .collect::<Result<Vec<_>>>()
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Some((open, close, tables)))
 }
 
 impl LightSpec {
