@@ -11,8 +11,8 @@ use crate::majorant_choice;
 use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGrid};
 use crate::pixel_sampler::PixelSampler;
 use crate::progress::Progress;
-use crate::shutter_lights::OverShutter;
 use crate::scene::{fitted_tile_size, Budget, Crop, RenderSettings, Scene};
+use crate::shutter_lights::OverShutter;
 use crate::stats::RenderStats;
 use cirrus_kernel::integrator::{
     CameraSampler, IntegratorKind, LightGrid, RayMarcher, TwoPassMarcher,

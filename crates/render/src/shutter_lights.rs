@@ -5,10 +5,10 @@
 //! so they share the frame's shadow grid and light groups; a scene whose
 //! lights hold still never comes here.
 
-use cirrus_kernel::{Counters, Ray};
 use cirrus_kernel::integrator::{CameraSampler, Sample};
 use cirrus_kernel::light::{Lights, LightsOverShutter};
 use cirrus_kernel::sampling::{Rng, SampleStream};
+use cirrus_kernel::{Counters, Ray};
 
 /// The samplers of the lights over the shutter, by table.
 pub(crate) struct OverShutter<'a, S> {

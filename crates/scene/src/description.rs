@@ -20,9 +20,9 @@ use cirrus_render::{
 
 use crate::declare::declare_settings;
 use crate::error::{Error, Result};
+use crate::light_keys::LightKey;
 #[cfg(feature = "clap")]
 use crate::parse;
-use crate::light_keys::LightKey;
 use crate::values::{check_samples, finite_matrix};
 pub use crate::values::{
     AxisAngle, BlackbodySpec, Colour, FileSample, Matrix, MatrixSample, ScaleSpec, TransformSpec,

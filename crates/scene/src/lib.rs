@@ -71,9 +71,9 @@ pub use denoise_tiles::merge_tiles;
 pub use description::OutputFlags;
 pub use description::SceneDescription;
 pub use error::{Error, ErrorKind, Result};
-pub use light_keys::LightKey;
 #[cfg(feature = "clap")]
 pub use flags::{settings_table, SceneFlags};
+pub use light_keys::LightKey;
 pub use output::{has_extension, write_whole, Outputs};
 pub use overrides::{examples, settings, Overrides};
 pub use plan::{VolumeCache, DENSITY_SCALE_PER_VOXEL};

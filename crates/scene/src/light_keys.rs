@@ -107,17 +107,22 @@ impl Keyed for f32 {
 
 impl Keyed for [f32; 3] {
     fn lerp(a: [f32; 3], b: [f32; 3], u: f32) -> [f32; 3] {
-        Vec3::from_array(a)
-            .lerp(Vec3::from_array(b), u)
-            .to_array()
+        Vec3::from_array(a).lerp(Vec3::from_array(b), u).to_array()
     }
 }
 
 /// The value `get` reads off the keys at `time`: interpolated between the
 /// two keys about it that give one, held outside them; `None` where no
 /// key gives it.
-fn keyed_at<T: Keyed>(keys: &[LightKey], time: f64, get: impl Fn(&LightKey) -> Option<T>) -> Option<T> {
-    let given: Vec<(f64, T)> = keys.iter().filter_map(|k| Some((k.time, get(k)?))).collect();
+fn keyed_at<T: Keyed>(
+    keys: &[LightKey],
+    time: f64,
+    get: impl Fn(&LightKey) -> Option<T>,
+) -> Option<T> {
+    let given: Vec<(f64, T)> = keys
+        .iter()
+        .filter_map(|k| Some((k.time, get(k)?)))
+        .collect();
     let after = given.partition_point(|(t, _)| *t <= time);
     match (after.checked_sub(1).map(|i| given[i]), given.get(after)) {
         (None, None) => None,
@@ -173,7 +178,10 @@ impl LightSpec {
                 return Err(format!("the key at time {} gives no value", k.time));
             }
             let shared = ["color", "intensity", "exposure"];
-            if let Some(name) = given.iter().find(|n| !takes.contains(n) && !shared.contains(n)) {
+            if let Some(name) = given
+                .iter()
+                .find(|n| !takes.contains(n) && !shared.contains(n))
+            {
                 return Err(format!(
                     "the key at time {}: `{name}` does not apply to a {} light",
                     k.time, self.kind
@@ -187,11 +195,18 @@ impl LightSpec {
         }
         for pair in keys.windows(2) {
             for (name, a, b) in [
-                ("direction", self.at(pair[0].time).direction, self.at(pair[1].time).direction),
+                (
+                    "direction",
+                    self.at(pair[0].time).direction,
+                    self.at(pair[1].time).direction,
+                ),
                 ("up", self.at(pair[0].time).up, self.at(pair[1].time).up),
             ] {
                 let (Some(a), Some(b)) = (a, b) else { continue };
-                let (a, b) = (Vec3::from_array(a).normalize(), Vec3::from_array(b).normalize());
+                let (a, b) = (
+                    Vec3::from_array(a).normalize(),
+                    Vec3::from_array(b).normalize(),
+                );
                 if a.dot(b) < -0.999 {
                     return Err(format!(
                         "`{name}` turns half round between the keys at times {} and {}: add a key between them",
@@ -306,12 +321,18 @@ mod tests {
             cone_angle: Some(10.0),
             ..key(0.0)
         }]);
-        assert!(e.contains("`cone_angle` does not apply to a point light"), "{e}");
+        assert!(
+            e.contains("`cone_angle` does not apply to a point light"),
+            "{e}"
+        );
         let e = check(vec![LightKey {
             intensity: Some(-1.0),
             ..key(3.0)
         }]);
-        assert!(e.contains("at the key at time 3") && e.contains("negative"), "{e}");
+        assert!(
+            e.contains("at the key at time 3") && e.contains("negative"),
+            "{e}"
+        );
         let mut spot = point();
         spot.kind = "spot".into();
         spot.cone_angle = Some(30.0);

@@ -292,18 +292,8 @@ pub fn lights(desc: &SceneDescription) -> Result<Lights> {
         list.push((spec.at(frame).light()?, index(group)));
     }
     let emission = index(DEFAULT_LIGHT_GROUPS[2]);
-    let shutter = over_shutter(desc, &list[first_table..])?;
-    let still = Lights::grouped(list.iter().cloned(), emission);
-    let shutter = shutter.and_then(|(open, close, tables)| {
-        let tables = tables
-            .into_iter()
-            .map(|table| {
-                let lights = list[..first_table].iter().cloned().chain(table);
-                Lights::grouped(lights, emission)
-            })
-            .collect();
-        LightsOverShutter::new(open, close, tables)
-    });
+    let shutter = over_shutter(desc, &list, first_table, emission)?;
+    let still = Lights::grouped(list, emission);
     Ok(match shutter {
         Some(s) => still.with_shutter(s),
         None => still,
@@ -315,18 +305,21 @@ pub fn lights(desc: &SceneDescription) -> Result<Lights> {
 /// moving volume's transform (`moving.rs`).
 const SHUTTER_TABLES: usize = 65;
 
-/// The open and close times and, at each of [`SHUTTER_TABLES`] times
-/// over the shutter, the `[[light]]`s (`frame_lights`, as made at the
-/// frame, with their groups) where any changes while the shutter is
-/// open; lights that hold still are the frame's in every table.
-#[allow(clippy::type_complexity)]
+/// The lights at [`SHUTTER_TABLES`] times over the shutter where any
+/// `[[light]]` changes while it is open: `frame` (the lights made at the
+/// frame with their groups, the `[[light]]`s from `first_light` on) with
+/// each moving light made again at each time.
 fn over_shutter(
     desc: &SceneDescription,
-    frame_lights: &[(Light, u8)],
-) -> Result<Option<(f32, f32, Vec<Vec<(Light, u8)>>)>> {
-    let frame = desc.frame();
+    frame: &[(Light, u8)],
+    first_light: usize,
+    emission_group: u8,
+) -> Result<Option<LightsOverShutter>> {
     let [open, close] = desc.render.shutter();
-    let (t0, t1) = (frame + f64::from(open), frame + f64::from(close));
+    let (t0, t1) = (
+        desc.frame() + f64::from(open),
+        desc.frame() + f64::from(close),
+    );
     let moving: Vec<bool> = desc.lights.iter().map(|l| l.moves_within(t0, t1)).collect();
     let Some(first) = moving.iter().position(|&m| m) else {
         return Ok(None);
@@ -338,21 +331,17 @@ fn over_shutter(
             desc.lights[first].label(first)
         )));
     }
+    let table = |time: f64| -> Result<Lights> {
+        let mut list = frame.to_vec();
+        for (i, spec) in desc.lights.iter().enumerate().filter(|(i, _)| moving[*i]) {
+            list[first_light + i].0 = spec.at(time).light()?;
+        }
+        Ok(Lights::grouped(list, emission_group))
+    };
     let tables = (0..SHUTTER_TABLES)
-        .map(|k| {
-            let time = t0 + (t1 - t0) * k as f64 / (SHUTTER_TABLES - 1) as f64;
-            desc.lights
-                .iter()
-                .zip(&moving)
-                .zip(frame_lights)
-                .map(|((spec, &moves), (still, group))| match moves {
-                    true => Ok((spec.at(time).light()?, *group)),
-                    false => Ok((still.clone(), *group)),
-                })
-                .collect::<Result<Vec<_>>>()
-        })
+        .map(|k| table(t0 + (t1 - t0) * k as f64 / (SHUTTER_TABLES - 1) as f64))
         .collect::<Result<Vec<_>>>()?;
-    Ok(Some((open, close, tables)))
+    Ok(LightsOverShutter::new(open, close, tables))
 }
 
 impl LightSpec {

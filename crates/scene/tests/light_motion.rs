@@ -94,13 +94,23 @@ fn a_light_moving_while_the_shutter_is_open_renders_the_mean_of_its_instants() {
     let instants: Vec<(Rendered, f64)> = (0..8)
         .map(|i| {
             let frame = (f64::from(i) + 0.5) / 8.0;
-            let r = render(&format!("spp = 16\nseed = {}\nframe = {frame}", 10 + i), CROSSING).unwrap();
+            let r = render(
+                &format!("spp = 16\nseed = {}\nframe = {frame}", 10 + i),
+                CROSSING,
+            )
+            .unwrap();
             (r, 1.0 / 8.0)
         })
         .collect();
-    for (i, (d, se)) in strip_differences(&blurred, &instants, 4).into_iter().enumerate() {
+    for (i, (d, se)) in strip_differences(&blurred, &instants, 4)
+        .into_iter()
+        .enumerate()
+    {
         eprintln!("strip {i}: {d} +- {se}");
-        assert!(d.abs() <= 4.0 * se, "strip {i}: blurred - mean of instants = {d} +- {se}");
+        assert!(
+            d.abs() <= 4.0 * se,
+            "strip {i}: blurred - mean of instants = {d} +- {se}"
+        );
     }
     // The same bound tells the blur from the light held at the open time.
     let opening = render("spp = 64\nseed = 9", CROSSING).unwrap();
@@ -108,7 +118,10 @@ fn a_light_moving_while_the_shutter_is_open_renders_the_mean_of_its_instants() {
         .into_iter()
         .map(|(d, se)| d.abs() / se)
         .fold(0.0, f64::max);
-    assert!(worst > 8.0, "the blur differs from the opening instant by {worst} standard errors");
+    assert!(
+        worst > 8.0,
+        "the blur differs from the opening instant by {worst} standard errors"
+    );
 }
 
 #[test]
@@ -117,9 +130,14 @@ fn a_closed_shutter_or_a_still_light_renders_as_without_keys() {
     let closed = render("shutter = [0, 0]", CROSSING).unwrap();
     assert_eq!(bits(&closed), bits(&render("", still).unwrap()));
     // Keys that hold the light still over the shutter cost no tables.
-    let held = format!("{still}keys = [{{ time = 0, intensity = 4e4 }}, {{ time = 1, intensity = 4e4 }}]\n");
+    let held = format!(
+        "{still}keys = [{{ time = 0, intensity = 4e4 }}, {{ time = 1, intensity = 4e4 }}]\n"
+    );
     let open = "shutter = [0, 1]";
-    assert_eq!(bits(&render(open, &held).unwrap()), bits(&render(open, still).unwrap()));
+    assert_eq!(
+        bits(&render(open, &held).unwrap()),
+        bits(&render(open, still).unwrap())
+    );
 }
 
 #[test]
@@ -129,15 +147,27 @@ fn bad_keys_and_moving_lights_the_integrator_cannot_blur_are_refused_by_name() {
         Err(e) => e.to_string(),
     };
     let e = err("", "[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nkeys = [{ time = 1, intensity = 2 }, { time = 0, intensity = 3 }]\n");
-    assert!(e.contains("light 1") && e.contains("keys: times must be finite and increasing"), "{e}");
+    assert!(
+        e.contains("light 1") && e.contains("keys: times must be finite and increasing"),
+        "{e}"
+    );
     let e = err("", "[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nkeys = [{ time = 0, cone_angle = 30 }]\n");
-    assert!(e.contains("`cone_angle` does not apply to a point light"), "{e}");
+    assert!(
+        e.contains("`cone_angle` does not apply to a point light"),
+        "{e}"
+    );
     let e = err("", "[[light]]\ntype = \"point\"\nkeys = [{ time = 0, position = [0, 0, 0] }, { time = 2, intensity = -1 }]\n");
-    assert!(e.contains("at the key at time") && e.contains("`intensity` is negative"), "{e}");
+    assert!(
+        e.contains("at the key at time") && e.contains("`intensity` is negative"),
+        "{e}"
+    );
     let e = err("", "[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nkeys = [{ time = 0, position = [0, 0] }]\n");
     assert!(e.contains("expected 3 numbers, got 2"), "{e}");
     let e = err("integrator = \"raymarch2pass\"\nshutter = [0, 1]", CROSSING);
-    assert!(e.contains("light 1 changes while the shutter is open") && e.contains("raymarch2pass"), "{e}");
+    assert!(
+        e.contains("light 1 changes while the shutter is open") && e.contains("raymarch2pass"),
+        "{e}"
+    );
     // Keys given only in the keys: the base needs no position of its own.
     render("", "[[light]]\ntype = \"point\"\nintensity = 4e4\nkeys = [{ time = 0, position = [60, 83, 100] }]\n").unwrap();
 }

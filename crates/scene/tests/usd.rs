@@ -618,9 +618,17 @@ fn time_sampled_lights_become_keyed_lights_that_render_as_their_toml_twins() {
     let p = write(&d, "lamps.usda", &text);
     let scene = Scene::load(&p).unwrap();
     let desc = scene.description();
-    assert_eq!(desc.sun.as_ref().unwrap().sun, Some(false), "a moving sun is a keyed light");
+    assert_eq!(
+        desc.sun.as_ref().unwrap().sun,
+        Some(false),
+        "a moving sun is a keyed light"
+    );
     let sun = desc.lights.iter().find(|l| l.kind == "distant").unwrap();
-    assert_eq!(sun.group.as_deref(), Some("sun"), "in the sun's layer still");
+    assert_eq!(
+        sun.group.as_deref(),
+        Some("sun"),
+        "in the sun's layer still"
+    );
     let lamp = desc.lights.iter().find(|l| l.kind == "sphere").unwrap();
     let keys = lamp.keys.as_ref().unwrap();
     assert_eq!(keys.iter().map(|k| k.time).collect::<Vec<_>>(), [1.0, 3.0]);
@@ -652,5 +660,8 @@ fn time_sampled_lights_become_keyed_lights_that_render_as_their_toml_twins() {
         s.apply(&small);
         s.render().unwrap()
     };
-    assert_ne!(first.image.rgba, r.image.rgba, "the lights move between frames");
+    assert_ne!(
+        first.image.rgba, r.image.rgba,
+        "the lights move between frames"
+    );
 }

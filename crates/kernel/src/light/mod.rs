@@ -331,7 +331,10 @@ impl Lights {
         let keep: Vec<bool> = (0..self.list.len())
             .map(|i| !self.list[i].is_black() || tables.iter().any(|t| !t.list[i].is_black()))
             .collect();
-        let shutter = self.shutter.as_deref().map(|m| Arc::new(m.map(|t| t.kept(&keep))));
+        let shutter = self
+            .shutter
+            .as_deref()
+            .map(|m| Arc::new(m.map(|t| t.kept(&keep))));
         Self {
             shutter,
             ..self.kept(&keep)

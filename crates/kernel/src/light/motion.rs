@@ -63,7 +63,11 @@ mod tests {
     use glam::Vec3;
 
     fn at(x: f32) -> Lights {
-        Lights::new([Light::from(SphereLight::new(Vec3::new(x, 0.0, 0.0), 0.0, Vec3::ONE))])
+        Lights::new([Light::from(SphereLight::new(
+            Vec3::new(x, 0.0, 0.0),
+            0.0,
+            Vec3::ONE,
+        ))])
     }
 
     #[test]

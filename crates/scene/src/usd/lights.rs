@@ -23,8 +23,8 @@ use glam::{DVec3, Vec3};
 use openusd::usd::Prim;
 
 use crate::description::{EnvironmentSpec, LightSpec, SunSpec};
-use crate::light_keys::LightKey;
 use crate::error::{Error, Result};
+use crate::light_keys::LightKey;
 
 use super::values::{
     attr_asset, attr_number, attr_text, attr_triple, sample_times, shown_number, value,
@@ -121,7 +121,10 @@ pub fn keyed(
         if at.kind != spec.kind {
             return Err(r.error(
                 path,
-                format!("the light is a {} at time {t} but a {} at the start: its kind cannot change", at.kind, spec.kind),
+                format!(
+                    "the light is a {} at time {t} but a {} at the start: its kind cannot change",
+                    at.kind, spec.kind
+                ),
             ));
         }
         keys.push(LightKey::of(&at, t));

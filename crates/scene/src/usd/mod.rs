@@ -324,7 +324,10 @@ fn lights(
     // change over time: then they are keyed `[[light]]`s in those layers.
     let start = r.time.start;
     let moves = |r: &Reader, p: &String| lights::change_times(r, p).map(|t| t.len() >= 2);
-    let sun = suns.first().map(|p| Ok::<_, Error>((p, moves(r, p)?))).transpose()?;
+    let sun = suns
+        .first()
+        .map(|p| Ok::<_, Error>((p, moves(r, p)?)))
+        .transpose()?;
     desc.sun = Some(match sun {
         Some((p, false)) => lights::distant(r, p, start)?,
         _ => SunSpec {
@@ -332,7 +335,10 @@ fn lights(
             ..Default::default()
         },
     });
-    let sky = domes.first().map(|p| Ok::<_, Error>((p, moves(r, p)?))).transpose()?;
+    let sky = domes
+        .first()
+        .map(|p| Ok::<_, Error>((p, moves(r, p)?)))
+        .transpose()?;
     desc.environment = Some(match sky {
         Some((p, false)) => lights::dome(r, p, start)?,
         _ => EnvironmentSpec {
@@ -352,21 +358,31 @@ fn lights(
         desc.lights.push(l);
     }
     for p in suns.iter().skip(1) {
-        desc.lights.push(lights::keyed(r, p, |r, t| lights::extra_distant(r, p, &name(p), t))?);
+        desc.lights.push(lights::keyed(r, p, |r, t| {
+            lights::extra_distant(r, p, &name(p), t)
+        })?);
     }
     for p in domes.iter().skip(1) {
-        desc.lights.push(lights::keyed(r, p, |r, t| lights::extra_dome(r, p, &name(p), t))?);
+        desc.lights.push(lights::keyed(r, p, |r, t| {
+            lights::extra_dome(r, p, &name(p), t)
+        })?);
     }
     for p in spheres {
-        desc.lights.push(lights::keyed(r, p, |r, t| lights::sphere(r, p, &name(p), t))?);
+        desc.lights.push(lights::keyed(r, p, |r, t| {
+            lights::sphere(r, p, &name(p), t)
+        })?);
     }
     for (kind, paths) in [("rect", rects), ("disk", disks)] {
         for p in paths {
-            desc.lights.push(lights::keyed(r, p, |r, t| lights::area(r, p, &name(p), kind, t))?);
+            desc.lights.push(lights::keyed(r, p, |r, t| {
+                lights::area(r, p, &name(p), kind, t)
+            })?);
         }
     }
     for p in cylinders {
-        desc.lights.push(lights::keyed(r, p, |r, t| lights::cylinder(r, p, &name(p), t))?);
+        desc.lights.push(lights::keyed(r, p, |r, t| {
+            lights::cylinder(r, p, &name(p), t)
+        })?);
     }
     if crate::lights::light_group_names(desc).is_err() {
         r.warn(format!(
