@@ -37,6 +37,7 @@ mod pixel_sampler;
 mod progress;
 mod render;
 mod scene;
+mod shutter_lights;
 mod stats;
 
 pub use cirrus_kernel as kernel;

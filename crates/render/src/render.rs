@@ -12,6 +12,7 @@ use crate::path_setup::{light_sampling_stat, path_tracer, shadow_grid, ShadowGri
 use crate::pixel_sampler::PixelSampler;
 use crate::progress::Progress;
 use crate::scene::{fitted_tile_size, Budget, Crop, RenderSettings, Scene};
+use crate::shutter_lights::OverShutter;
 use crate::stats::RenderStats;
 use cirrus_kernel::integrator::{
     CameraSampler, IntegratorKind, LightGrid, RayMarcher, TwoPassMarcher,
@@ -202,15 +203,32 @@ fn integrate<M: Media>(
             let tracer = path_tracer(medium, &lights, settings, shadows);
             let light_sampling = light_sampling_stat(settings, &tracer, shadows);
             let setup = start.elapsed().as_secs_f64();
+            let resolved = match lights.over_shutter() {
+                None => run(&tracer, camera, settings, start, counters),
+                Some(shutter) => {
+                    let make = |l: &Lights| path_tracer(medium, l, settings, shadows);
+                    let s = OverShutter::new(shutter, make);
+                    run(&s, camera, settings, start, counters)
+                }
+            };
             Integrated {
                 light_sampling,
-                ..done(run(&tracer, camera, settings, start, counters), setup)
+                ..done(resolved, setup)
             }
         }
         IntegratorKind::RayMarch => {
-            let s = RayMarcher::new(medium, lights, settings.step_voxels)
-                .with_shadow_step(settings.shadow_step());
-            done(run(&s, camera, settings, start, counters), 0.0)
+            let marcher = |l: &Lights| {
+                RayMarcher::new(medium, l.clone(), settings.step_voxels)
+                    .with_shadow_step(settings.shadow_step())
+            };
+            let resolved = match lights.over_shutter() {
+                None => run(&marcher(&lights), camera, settings, start, counters),
+                Some(shutter) => {
+                    let s = OverShutter::new(shutter, marcher);
+                    run(&s, camera, settings, start, counters)
+                }
+            };
+            done(resolved, 0.0)
         }
         IntegratorKind::RayMarch2Pass => {
             let grid = LightGrid::build(

@@ -20,6 +20,7 @@ use cirrus_render::{
 
 use crate::declare::declare_settings;
 use crate::error::{Error, Result};
+use crate::light_keys::LightKey;
 #[cfg(feature = "clap")]
 use crate::parse;
 use crate::values::{check_samples, finite_matrix};
@@ -317,6 +318,11 @@ declare_settings! {
         map: Option<PathBuf>;
         /// A dome map's rotation about +Y in degrees.
         rotation: Option<f32>;
+        /// Values over time, `[{ time, position = [..], intensity = .. }]`
+        /// (frames, increasing): each value keyed is interpolated linearly
+        /// between the keys giving it and held outside them; motion blur
+        /// where it changes while the shutter is open.
+        keys: Option<Vec<LightKey>>;
     }
     }
 

@@ -48,6 +48,7 @@ pub mod frames;
 pub mod grids;
 pub mod info;
 mod light_checks;
+mod light_keys;
 pub mod lights;
 mod moving;
 mod output;
@@ -72,6 +73,7 @@ pub use description::SceneDescription;
 pub use error::{Error, ErrorKind, Result};
 #[cfg(feature = "clap")]
 pub use flags::{settings_table, SceneFlags};
+pub use light_keys::LightKey;
 pub use output::{has_extension, write_whole, Outputs};
 pub use overrides::{examples, settings, Overrides};
 pub use plan::{VolumeCache, DENSITY_SCALE_PER_VOXEL};

@@ -99,7 +99,8 @@ impl LightSpec {
     }
 
     /// Checks the light on its own: its kind, the keys its kind takes,
-    /// and every value finite and in range.
+    /// and every value finite and in range, at each of its keys where it
+    /// has any ([`LightSpec::check_keys`]).
     pub fn check(&self) -> std::result::Result<(), String> {
         let kind = self.kind.as_str();
         if !KINDS.contains(&kind) {
@@ -108,6 +109,15 @@ impl LightSpec {
                 KINDS.join(", ")
             ));
         }
+        match self.keys {
+            Some(_) => self.check_keys(keys_of(kind)),
+            None => self.check_unkeyed(),
+        }
+    }
+
+    /// [`Self::check`] of a light whose keys are folded in.
+    pub(crate) fn check_unkeyed(&self) -> std::result::Result<(), String> {
+        let kind = self.kind.as_str();
         let takes = keys_of(kind);
         if let Some(key) = self.given().into_iter().find(|k| !takes.contains(k)) {
             return Err(format!("`{key}` does not apply to a {kind} light"));

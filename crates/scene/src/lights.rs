@@ -21,7 +21,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 use cirrus_render::compositing::{DEFAULT_LIGHT_GROUPS, MAX_LIGHT_GROUPS};
-use cirrus_render::{AreaLight, AreaShape, Environment, Light, Lights, SphereLight, Spot, Sun};
+use cirrus_render::kernel::light::LightsOverShutter;
+use cirrus_render::{
+    AreaLight, AreaShape, Environment, IntegratorKind, Light, Lights, SphereLight, Spot, Sun,
+};
 use glam::Vec3;
 
 use crate::description::{LightSpec, SceneDescription};
@@ -279,15 +282,67 @@ pub fn lights(desc: &SceneDescription) -> Result<Lights> {
         };
         list.push((light.into(), index(DEFAULT_LIGHT_GROUPS[1])));
     }
+    let frame = desc.frame();
+    let first_table = list.len();
     for spec in &desc.lights {
         let group = if names.iter().any(|n| n == spec.group_name()) {
             spec.group_name()
         } else {
             kind_layer(spec)
         };
-        list.push((spec.light()?, index(group)));
+        list.push((spec.at(frame).light()?, index(group)));
     }
-    Ok(Lights::grouped(list, index(DEFAULT_LIGHT_GROUPS[2])).pruned())
+    let emission = index(DEFAULT_LIGHT_GROUPS[2]);
+    let shutter = over_shutter(desc, &list, first_table, emission)?;
+    let still = Lights::grouped(list, emission);
+    Ok(match shutter {
+        Some(s) => still.with_shutter(s),
+        None => still,
+    }
+    .pruned())
+}
+
+/// Times a moving light is tabulated at over the shutter: as many as a
+/// moving volume's transform (`moving.rs`).
+const SHUTTER_TABLES: usize = 65;
+
+/// The lights at [`SHUTTER_TABLES`] times over the shutter where any
+/// `[[light]]` changes while it is open: `frame` (the lights made at the
+/// frame with their groups, the `[[light]]`s from `first_light` on) with
+/// each moving light made again at each time.
+fn over_shutter(
+    desc: &SceneDescription,
+    frame: &[(Light, u8)],
+    first_light: usize,
+    emission_group: u8,
+) -> Result<Option<LightsOverShutter>> {
+    let [open, close] = desc.render.shutter();
+    let (t0, t1) = (
+        desc.frame() + f64::from(open),
+        desc.frame() + f64::from(close),
+    );
+    let moving: Vec<bool> = desc.lights.iter().map(|l| l.moves_within(t0, t1)).collect();
+    let Some(first) = moving.iter().position(|&m| m) else {
+        return Ok(None);
+    };
+    if desc.render.integrator() == IntegratorKind::RayMarch2Pass {
+        return Err(Error::input(format!(
+            "{} changes while the shutter is open: raymarch2pass caches the light at one time; \
+             render it with the path tracer or raymarch, or close the shutter",
+            desc.lights[first].label(first)
+        )));
+    }
+    let table = |time: f64| -> Result<Lights> {
+        let mut list = frame.to_vec();
+        for (i, spec) in desc.lights.iter().enumerate().filter(|(i, _)| moving[*i]) {
+            list[first_light + i].0 = spec.at(time).light()?;
+        }
+        Ok(Lights::grouped(list, emission_group))
+    };
+    let tables = (0..SHUTTER_TABLES)
+        .map(|k| table(t0 + (t1 - t0) * k as f64 / (SHUTTER_TABLES - 1) as f64))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(LightsOverShutter::new(open, close, tables))
 }
 
 impl LightSpec {

@@ -2,7 +2,8 @@
 //! `[environment]` shorthands, and UsdLux stages, each with values drawn
 //! from the edges of f32 and f64 (zeros of either sign, subnormals, 1e19
 //! to 1e300, infinities, NaN), arrays of the wrong length and names
-//! outside Latin-1. Every case must end in a clean error naming the file,
+//! outside Latin-1, and keys over time (frames between keys, open
+//! shutters, USD time samples). Every case must end in a clean error naming the file,
 //! or a render whose pixels are all finite and that dropped no sample to
 //! NaN or infinity: never a panic, a hang or a silent black image.
 //!
@@ -135,7 +136,36 @@ fn light_table(rng: &mut SplitMix64) -> String {
             t.push('\n');
         }
     }
+    if rng.below(3) == 0 {
+        t += &light_keys(rng);
+    }
     t
+}
+
+/// A light's `keys`: two or three, at times sometimes out of order or not
+/// finite, each with a few values (now and then one its kind does not take).
+fn light_keys(rng: &mut SplitMix64) -> String {
+    let keys: Vec<String> = (0..2 + rng.below(2))
+        .map(|k| {
+            let time = number(rng, &k.to_string());
+            let mut values = vec![format!("time = {time}")];
+            let choices = [
+                format!("position = {}", vector(rng, ["0", "300", "0"])),
+                format!("direction = {}", vector(rng, ["0", "-1", "0"])),
+                format!("intensity = {}", number(rng, "1000")),
+                format!("color = {}", vector(rng, ["1", "0.9", "0.8"])),
+                format!("radius = {}", number(rng, "10")),
+                format!("cone_angle = {}", number(rng, "30")),
+            ];
+            for c in choices {
+                if rng.below(3) == 0 {
+                    values.push(c);
+                }
+            }
+            format!("{{ {} }}", values.join(", "))
+        })
+        .collect();
+    format!("keys = [{}]\n", keys.join(", "))
 }
 
 /// A scene file: a cloud and some lights, or the shorthand tables.
@@ -154,6 +184,12 @@ fn scene_text(rng: &mut SplitMix64) -> String {
         for _ in 0..1 + rng.below(3) {
             text += &light_table(rng);
         }
+    }
+    // Keyed lights read at a frame between keys, or blurred over a shutter.
+    match rng.below(4) {
+        0 => text += &format!("[render]\nframe = {}\n", number(rng, "0.5")),
+        1 => text += &format!("[render]\nshutter = [0, {}]\n", number(rng, "1")),
+        _ => {}
     }
     text
 }
@@ -201,6 +237,18 @@ fn usd_light(rng: &mut SplitMix64, i: usize) -> String {
             "float inputs:shaping:cone:angle = {}",
             usd_number(rng, "30")
         ));
+    }
+    // Time-sampled: a moving, brightening light (keyed light).
+    if rng.below(3) == 0 {
+        attrs[3] = format!(
+            "double3 xformOp:translate.timeSamples = {{ 1: (0, 300, 0), {}: ({}, 300, 0) }}",
+            usd_number(rng, "3"),
+            usd_number(rng, "50")
+        );
+        attrs[0] = format!(
+            "float inputs:intensity.timeSamples = {{ 1: 1000, 2: {} }}",
+            usd_number(rng, "2000")
+        );
     }
     // Doubles as USD writes them: some finite in f64 and not in f32.
     if rng.below(3) == 0 {

@@ -591,3 +591,77 @@ fn a_distant_light_too_dim_to_see_is_warned_about() {
     let w = warnings("        bool inputs:normalize = 1\n");
     assert!(!w.contains("/World/Sun"), "{w}");
 }
+
+#[test]
+fn time_sampled_lights_become_keyed_lights_that_render_as_their_toml_twins() {
+    let d = dir("moving_lights");
+    let body = format!(
+        r#"{}
+    def SphereLight "Lamp"
+    {{
+        float inputs:intensity.timeSamples = {{ 1: 2, 3: 6 }}
+        float inputs:radius = 0.5
+        double3 xformOp:translate.timeSamples = {{ 1: (0, 2, 0), 3: (4, 2, 0) }}
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }}
+    def DistantLight "Sun"
+    {{
+        float inputs:intensity = 3
+        float inputs:angle = 0
+        float3 xformOp:rotateX.timeSamples = {{ 1: -90, 3: -60 }}
+        uniform token[] xformOpOrder = ["xformOp:rotateX"]
+    }}
+"#,
+        volume("Cloud", "./cloud.vdb", "density")
+    );
+    let text = stage(&body).replace("endTimeCode = 1", "endTimeCode = 3");
+    let p = write(&d, "lamps.usda", &text);
+    let scene = Scene::load(&p).unwrap();
+    let desc = scene.description();
+    assert_eq!(
+        desc.sun.as_ref().unwrap().sun,
+        Some(false),
+        "a moving sun is a keyed light"
+    );
+    let sun = desc.lights.iter().find(|l| l.kind == "distant").unwrap();
+    assert_eq!(
+        sun.group.as_deref(),
+        Some("sun"),
+        "in the sun's layer still"
+    );
+    let lamp = desc.lights.iter().find(|l| l.kind == "sphere").unwrap();
+    let keys = lamp.keys.as_ref().unwrap();
+    assert_eq!(keys.iter().map(|k| k.time).collect::<Vec<_>>(), [1.0, 3.0]);
+    assert_eq!(keys[1].position, Some([4.0, 2.0, 0.0]));
+    assert_eq!(keys[1].color, Some([6.0; 3]));
+    // Frame 2 is halfway: the lamp at (2, 2, 0) of radiance 4, the sun
+    // turned 75 degrees; the same light as a scene file renders the same.
+    let at2 = lamp.at(2.0);
+    assert_eq!(at2.position, Some([2.0, 2.0, 0.0]));
+    assert_eq!(at2.color, Some([4.0; 3]));
+    let small = Overrides {
+        res: Some((16, 12)),
+        spp: Some(2),
+        ..Default::default()
+    };
+    let mut usd = scene.for_frame(2);
+    usd.apply(&small);
+    let r = usd.render().unwrap();
+    let mut twin = usd.description().clone();
+    for l in &mut twin.lights {
+        *l = l.at(2.0);
+    }
+    let mut twin = Scene::from_description(twin, &d).unwrap();
+    twin.apply(&small);
+    let t = twin.render().unwrap();
+    assert_eq!(r.image.rgba, t.image.rgba);
+    let first = {
+        let mut s = scene.for_frame(1);
+        s.apply(&small);
+        s.render().unwrap()
+    };
+    assert_ne!(
+        first.image.rgba, r.image.rgba,
+        "the lights move between frames"
+    );
+}

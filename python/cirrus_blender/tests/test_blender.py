@@ -468,3 +468,43 @@ def test_an_animation_renders_every_frame_with_depth(addon, tmp_path):
     img = bpy.data.images.load(str(tmp_path / "anim_0001.exr"))
     px = np.array(img.pixels[:]).reshape(16, 16, 4)
     assert px[..., 3].max() > 0.0, "the cloud covers some pixels"
+
+
+def test_a_keyframed_lamp_is_exported_as_blender_evaluates_it_at_each_frame(addon):
+    """Keyframes on a lamp's location and power reach each frame's
+    description as Blender evaluates them there; the lamp holds still over
+    the shutter (Cycles' lamps take no motion blur), so no keys are written."""
+    scene, _ = build_scene()
+    lights_off(scene)
+    data = bpy.data.lights.new("Ember", "POINT")
+    data.shadow_soft_size = 0.0
+    lamp = bpy.data.objects.new("Ember", data)
+    scene.collection.objects.link(lamp)
+    for frame, x, energy in ((1, 0.0, 100.0), (3, 2.0, 300.0)):
+        lamp.location = (x, 5.0, 1.0)
+        data.energy = energy
+        lamp.keyframe_insert("location", frame=frame)
+        data.keyframe_insert("energy", frame=frame)
+    for action in (lamp.animation_data.action, data.animation_data.action):
+        for fcurve in fcurves(action):
+            for k in fcurve.keyframe_points:
+                k.interpolation = "LINEAR"
+    scene.render.use_motion_blur = True
+    for frame, x, energy in ((1, 0.0, 100.0), (2, 1.0, 200.0), (3, 2.0, 300.0)):
+        scene.frame_set(frame)
+        desc, _ = addon.export.scene_description(bpy.context.evaluated_depsgraph_get(), (8, 8))
+        ember = next(l for l in desc["light"] if l["name"] == "Ember")
+        # Blender's (x, y, z) is cirrus's (x, z, -y).
+        assert ember["position"] == pytest.approx([x, 1.0, -5.0], abs=1e-5)
+        assert ember["color"] == pytest.approx([energy / (4.0 * math.pi)] * 3, rel=1e-5)
+        assert "keys" not in ember
+        assert desc["render"]["shutter"][1] > desc["render"]["shutter"][0]
+
+
+def fcurves(action):
+    """An action's F-curves: on its layered channelbags (Blender 4.4 on) or
+    its own list."""
+    if hasattr(action, "layers") and action.layers:
+        return [fc for layer in action.layers for strip in layer.strips
+                for bag in strip.channelbags for fc in bag.fcurves]
+    return list(action.fcurves)

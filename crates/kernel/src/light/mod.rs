@@ -16,6 +16,7 @@ mod dome;
 mod facing_disk;
 mod interface;
 mod limits;
+mod motion;
 mod sphere;
 mod spherical_rect;
 
@@ -25,7 +26,10 @@ pub use distant::Sun;
 pub use dome::Environment;
 pub use interface::{LightHit, Whence};
 pub use limits::{shown, MAX_LIGHT_EXTENT, MAX_LIGHT_VALUE};
+pub use motion::LightsOverShutter;
 pub use sphere::{SphereLight, Spot};
+
+use std::sync::Arc;
 
 use glam::Vec3;
 
@@ -175,6 +179,8 @@ pub struct Lights {
     /// [`Self::at_infinity`], kept so that an escaping ray does not walk
     /// every light of a scene of thousands.
     at_infinity: Vec<u32>,
+    /// The same lights over an open shutter, where they change in it.
+    shutter: Option<Arc<LightsOverShutter>>,
 }
 
 /// The indices of the lights of `list` at infinity.
@@ -208,6 +214,7 @@ impl Lights {
             list,
             groups,
             emission_group: DEFAULT_GROUP_EMISSION,
+            shutter: None,
         }
     }
 
@@ -222,12 +229,27 @@ impl Lights {
             list,
             groups,
             emission_group,
+            shutter: None,
         }
     }
 
     /// A sun and a sky, either absent: the usual outdoor pair.
     pub fn sun_and_sky(sun: Option<Sun>, sky: Option<Environment>) -> Self {
         Self::new(sun.map(Light::from).into_iter().chain(sky.map(Light::from)))
+    }
+
+    /// The lights with how they change over an open shutter: `shutter`'s
+    /// tables hold these lights (the frame's) at times over it.
+    pub fn with_shutter(mut self, shutter: LightsOverShutter) -> Self {
+        self.shutter = Some(Arc::new(shutter));
+        self
+    }
+
+    /// The lights over the shutter, where they change while it is open
+    /// (the render takes a camera sample's lights from the table nearest
+    /// its time); `None` where these lights hold all the while.
+    pub fn over_shutter(&self) -> Option<&LightsOverShutter> {
+        self.shutter.as_deref()
     }
 
     /// The lights, in the order their samples are drawn.
@@ -296,6 +318,9 @@ impl Lights {
     /// is world space minus a centre kept in f64, so that f32 stays
     /// precise far from the world's origin); directions are unchanged.
     pub fn relative_to(mut self, origin: glam::DVec3) -> Self {
+        if let Some(m) = self.shutter.take() {
+            self.shutter = Some(Arc::new(m.map(|l| l.relative_to(origin))));
+        }
         for light in &mut self.list {
             match light {
                 Light::Sphere(s) => *s = s.moved_to((s.position().as_dvec3() - origin).as_vec3()),
@@ -308,18 +333,38 @@ impl Lights {
 
     /// Drops lights that deliver nothing (zero irradiance or radiance), so
     /// they cost nothing either; the others keep their order and groups.
+    /// A light that changes over the shutter is dropped only where it is
+    /// black in every table.
     pub fn pruned(self) -> Self {
+        let tables = self.shutter.as_deref().map_or(&[][..], |m| m.tables());
+        let keep: Vec<bool> = (0..self.list.len())
+            .map(|i| !self.list[i].is_black() || tables.iter().any(|t| !t.list[i].is_black()))
+            .collect();
+        let shutter = self
+            .shutter
+            .as_deref()
+            .map(|m| Arc::new(m.map(|t| t.kept(&keep))));
+        Self {
+            shutter,
+            ..self.kept(&keep)
+        }
+    }
+
+    /// The lights whose `keep` is true, in order, with their groups.
+    fn kept(self, keep: &[bool]) -> Self {
         let (list, groups): (Vec<Light>, Vec<u8>) = self
             .list
             .into_iter()
             .zip(self.groups)
-            .filter(|(l, _)| !l.is_black())
+            .zip(keep)
+            .filter_map(|(l, &k)| k.then_some(l))
             .unzip();
         Self {
             at_infinity: at_infinity(&list),
             list,
             groups,
             emission_group: self.emission_group,
+            shutter: None,
         }
     }
 }

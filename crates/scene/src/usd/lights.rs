@@ -25,9 +25,12 @@ use openusd::usd::Prim;
 
 use crate::description::{EnvironmentSpec, LightSpec, SunSpec};
 use crate::error::{Error, Result};
+use crate::light_keys::LightKey;
 
-use super::values::{attr_asset, attr_number, attr_text, attr_triple, shown_number, value};
-use super::xform::world_at;
+use super::values::{
+    attr_asset, attr_number, attr_text, attr_triple, sample_times, shown_number, value,
+};
+use super::xform::{sample_times_of, world_at};
 use super::Reader;
 
 /// An input by its UsdLux name, or the pre-`inputs:` name older files use.
@@ -47,9 +50,8 @@ fn flag(p: &Prim, name: &str, t: f64) -> Result<bool> {
 }
 
 /// `intensity x 2^exposure x color`, with the light's intensity fallback.
-fn emission(r: &mut Reader, path: &str, intensity_fallback: f64) -> Result<Vec3> {
+fn emission(r: &mut Reader, path: &str, intensity_fallback: f64, t: f64) -> Result<Vec3> {
     let p = r.stage.prim(path);
-    let t = r.time.start;
     let intensity = input_number(&p, "intensity", t)?.unwrap_or(intensity_fallback);
     let exposure = input_number(&p, "exposure", t)?.unwrap_or(0.0);
     let colour = match attr_triple(&p, "inputs:color", t)? {
@@ -83,18 +85,66 @@ fn checked(r: &Reader, path: &str, spec: LightSpec) -> Result<LightSpec> {
     Ok(spec)
 }
 
+/// The times the light at `path` changes at: its attributes' samples and
+/// its transform's, sorted, deduplicated.
+pub(super) fn change_times(r: &Reader, path: &str) -> Result<Vec<f64>> {
+    let attributes = r
+        .stage
+        .prim(path)
+        .attributes()
+        .map_err(|e| r.error(path, format!("{e:#}")))?;
+    let mut times = sample_times_of(&r.stage, path)?;
+    for a in &attributes {
+        times.extend(sample_times(a)?);
+    }
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    Ok(times)
+}
+
+/// The `[[light]]` `read` makes of the light at `path` at the stage's
+/// start, keyed at each time its values or transform are sampled at where
+/// there are two or more (its flags, such as `normalize`, read at the
+/// start).
+pub fn keyed(
+    r: &mut Reader,
+    path: &str,
+    read: impl Fn(&mut Reader, f64) -> Result<LightSpec>,
+) -> Result<LightSpec> {
+    let times = change_times(r, path)?;
+    let mut spec = read(r, r.time.start)?;
+    if times.len() < 2 {
+        return Ok(spec);
+    }
+    let mut keys = Vec::with_capacity(times.len());
+    for &t in &times {
+        let at = read(r, t)?;
+        if at.kind != spec.kind {
+            return Err(r.error(
+                path,
+                format!(
+                    "the light is a {} at time {t} but a {} at the start: its kind cannot change",
+                    at.kind, spec.kind
+                ),
+            ));
+        }
+        keys.push(LightKey::of(&at, t));
+    }
+    spec.keys = Some(keys);
+    checked(r, path, spec)
+}
+
 /// Below this irradiance (W/m^2, a 250th of the default sun's) a distant
 /// light lights nothing a render shows; a stage's light that weak is
 /// most often one authored for `normalize` without it.
 const DIM_IRRADIANCE: f32 = 0.01;
 
 /// The sun of the `DistantLight` at `path`.
-pub fn distant(r: &mut Reader, path: &str) -> Result<SunSpec> {
+pub fn distant(r: &mut Reader, path: &str, t: f64) -> Result<SunSpec> {
     let p = r.stage.prim(path);
-    let t = r.time.start;
     let angle = input_number(&p, "angle", t)?.unwrap_or(0.53);
     let normalize = flag(&p, "inputs:normalize", t)?;
-    let radiance = emission(r, path, 50000.0)?;
+    let radiance = emission(r, path, 50000.0, t)?;
     let half = (0.5 * angle).to_radians();
     let irradiance = if normalize || angle <= 0.0 {
         radiance
@@ -133,10 +183,9 @@ pub fn distant(r: &mut Reader, path: &str) -> Result<SunSpec> {
 }
 
 /// The sky of the `DomeLight` at `path`.
-pub fn dome(r: &mut Reader, path: &str) -> Result<EnvironmentSpec> {
+pub fn dome(r: &mut Reader, path: &str, t: f64) -> Result<EnvironmentSpec> {
     let p = r.stage.prim(path);
-    let t = r.time.start;
-    let radiance = emission(r, path, 1.0)?;
+    let radiance = emission(r, path, 1.0, t)?;
     let world = world_at(&r.stage, path, t)?;
     // The dome turns about +Y only: where its X axis points.
     let x = world.transform_vector3(DVec3::X).normalize_or_zero();
@@ -189,8 +238,8 @@ pub fn dome(r: &mut Reader, path: &str) -> Result<EnvironmentSpec> {
 
 /// A `[[light]]` named `name` of the distant light at `path` (its sun
 /// table's numbers).
-pub fn extra_distant(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
-    let sun = distant(r, path)?;
+pub fn extra_distant(r: &mut Reader, path: &str, name: &str, t: f64) -> Result<LightSpec> {
+    let sun = distant(r, path, t)?;
     checked(
         r,
         path,
@@ -206,8 +255,8 @@ pub fn extra_distant(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec
 }
 
 /// A `[[light]]` named `name` of the dome light at `path`.
-pub fn extra_dome(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
-    let env = dome(r, path)?;
+pub fn extra_dome(r: &mut Reader, path: &str, name: &str, t: f64) -> Result<LightSpec> {
+    let env = dome(r, path, t)?;
     checked(
         r,
         path,
@@ -225,10 +274,9 @@ pub fn extra_dome(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
 
 /// The `[[light]]` named `name` of the `SphereLight` at `path`: a sphere,
 /// a point, or either shaped into a spot.
-pub fn sphere(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
+pub fn sphere(r: &mut Reader, path: &str, name: &str, t: f64) -> Result<LightSpec> {
     let p = r.stage.prim(path);
-    let t = r.time.start;
-    let strength = emission(r, path, 1.0)?;
+    let strength = emission(r, path, 1.0, t)?;
     let normalize = flag(&p, "inputs:normalize", t)?;
     let as_point = flag(&p, "treatAsPoint", t)?;
     let radius = input_number(&p, "radius", t)?.unwrap_or(0.5);
@@ -297,10 +345,9 @@ pub fn sphere(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
 /// The `[[light]]` named `name` of the `RectLight` or `DiskLight` at
 /// `path` (`kind` `rect` or `disk`): its shape in the light's XY plane
 /// scaled by its world transform, emitting along its -Z.
-pub fn area(r: &mut Reader, path: &str, name: &str, kind: &str) -> Result<LightSpec> {
+pub fn area(r: &mut Reader, path: &str, name: &str, kind: &str, t: f64) -> Result<LightSpec> {
     let p = r.stage.prim(path);
-    let t = r.time.start;
-    let strength = emission(r, path, 1.0)?;
+    let strength = emission(r, path, 1.0, t)?;
     let normalize = flag(&p, "inputs:normalize", t)?;
     let world = world_at(&r.stage, path, t)?;
     let (x, y) = (
@@ -356,10 +403,9 @@ pub fn area(r: &mut Reader, path: &str, name: &str, kind: &str) -> Result<LightS
 /// scale and its radius by the mean of the Y and Z scales, emitting
 /// outward (its caps dark). `treatAsLine` is named in a warning: the
 /// cylinder keeps its radius.
-pub fn cylinder(r: &mut Reader, path: &str, name: &str) -> Result<LightSpec> {
+pub fn cylinder(r: &mut Reader, path: &str, name: &str, t: f64) -> Result<LightSpec> {
     let p = r.stage.prim(path);
-    let t = r.time.start;
-    let strength = emission(r, path, 1.0)?;
+    let strength = emission(r, path, 1.0, t)?;
     let normalize = flag(&p, "inputs:normalize", t)?;
     if flag(&p, "treatAsLine", t)? {
         r.warn(format!(

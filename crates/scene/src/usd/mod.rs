@@ -42,6 +42,8 @@ use std::path::Path;
 
 use openusd::usd::{PrimPredicate, Stage};
 
+use cirrus_render::compositing::DEFAULT_LIGHT_GROUPS;
+
 use crate::description::{EnvironmentSpec, SceneDescription, SunSpec};
 use crate::error::{Error, Result};
 
@@ -318,37 +320,69 @@ fn lights(
     [rects, disks, cylinders]: &[Vec<String>; 3],
     desc: &mut SceneDescription,
 ) -> Result<()> {
-    desc.sun = Some(match suns.first() {
-        Some(p) => lights::distant(r, p)?,
-        None => SunSpec {
+    // The first distant and dome lights are the sun and sky, unless they
+    // change over time: then they are keyed `[[light]]`s in those layers.
+    let start = r.time.start;
+    let moves = |r: &Reader, p: &String| lights::change_times(r, p).map(|t| t.len() >= 2);
+    let sun = suns
+        .first()
+        .map(|p| Ok::<_, Error>((p, moves(r, p)?)))
+        .transpose()?;
+    desc.sun = Some(match sun {
+        Some((p, false)) => lights::distant(r, p, start)?,
+        _ => SunSpec {
             sun: Some(false),
             ..Default::default()
         },
     });
-    desc.environment = Some(match domes.first() {
-        Some(p) => lights::dome(r, p)?,
-        None => EnvironmentSpec {
+    let sky = domes
+        .first()
+        .map(|p| Ok::<_, Error>((p, moves(r, p)?)))
+        .transpose()?;
+    desc.environment = Some(match sky {
+        Some((p, false)) => lights::dome(r, p, start)?,
+        _ => EnvironmentSpec {
             env_radiance: Some([0.0; 3]),
             ..Default::default()
         },
     });
     let name = |path: &str| path.rsplit('/').next().unwrap_or(path).to_string();
+    if let Some((p, true)) = sun {
+        let mut l = lights::keyed(r, p, |r, t| lights::extra_distant(r, p, &name(p), t))?;
+        l.group = Some(DEFAULT_LIGHT_GROUPS[0].into());
+        desc.lights.push(l);
+    }
+    if let Some((p, true)) = sky {
+        let mut l = lights::keyed(r, p, |r, t| lights::extra_dome(r, p, &name(p), t))?;
+        l.group = Some(DEFAULT_LIGHT_GROUPS[1].into());
+        desc.lights.push(l);
+    }
     for p in suns.iter().skip(1) {
-        desc.lights.push(lights::extra_distant(r, p, &name(p))?);
+        desc.lights.push(lights::keyed(r, p, |r, t| {
+            lights::extra_distant(r, p, &name(p), t)
+        })?);
     }
     for p in domes.iter().skip(1) {
-        desc.lights.push(lights::extra_dome(r, p, &name(p))?);
+        desc.lights.push(lights::keyed(r, p, |r, t| {
+            lights::extra_dome(r, p, &name(p), t)
+        })?);
     }
     for p in spheres {
-        desc.lights.push(lights::sphere(r, p, &name(p))?);
+        desc.lights.push(lights::keyed(r, p, |r, t| {
+            lights::sphere(r, p, &name(p), t)
+        })?);
     }
     for (kind, paths) in [("rect", rects), ("disk", disks)] {
         for p in paths {
-            desc.lights.push(lights::area(r, p, &name(p), kind)?);
+            desc.lights.push(lights::keyed(r, p, |r, t| {
+                lights::area(r, p, &name(p), kind, t)
+            })?);
         }
     }
     for p in cylinders {
-        desc.lights.push(lights::cylinder(r, p, &name(p))?);
+        desc.lights.push(lights::keyed(r, p, |r, t| {
+            lights::cylinder(r, p, &name(p), t)
+        })?);
     }
     if crate::lights::light_group_names(desc).is_err() {
         r.warn(format!(
