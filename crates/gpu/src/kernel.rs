@@ -64,11 +64,12 @@ struct Buffers {
     map: wgpu::Buffer,
     atlas: wgpu::Buffer,
     constants: wgpu::Buffer,
-    majorants: wgpu::Buffer,
+    pyramid: wgpu::Buffer,
     lights: wgpu::Buffer,
     film: wgpu::Buffer,
     paths: wgpu::Buffer,
     pending: wgpu::Buffer,
+    partition: wgpu::Buffer,
 }
 
 /// Refuses a scene or window whose arrays exceed what a binding holds.
@@ -126,9 +127,10 @@ fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64) -> Buffers {
             bytemuck::cast_slice(&scene.constants),
             U::STORAGE,
         ),
-        majorants: init(
-            "majorants",
-            bytemuck::cast_slice(&scene.majorants),
+        pyramid: init("pyramid", bytemuck::cast_slice(&scene.pyramid), U::STORAGE),
+        partition: init(
+            "partition",
+            bytemuck::cast_slice(&scene.partition),
             U::STORAGE,
         ),
         lights: init("lights", bytemuck::cast_slice(&scene.lights), U::STORAGE),
@@ -183,11 +185,12 @@ impl<'g> Kernel<'g> {
             &b.map,
             &b.atlas,
             &b.constants,
-            &b.majorants,
+            &b.pyramid,
             &b.lights,
             &b.film,
             &b.paths,
             &b.pending,
+            &b.partition,
         ];
         let entries: Vec<wgpu::BindGroupEntry> = bound
             .iter()

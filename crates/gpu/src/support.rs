@@ -6,8 +6,8 @@ use cirrus_bricks::Precision;
 use cirrus_kernel::medium::BrickField;
 use cirrus_kernel::transform_motion::MovingField;
 use cirrus_render::{
-    IntegratorKind, Light, LightSampling, MajorantMode, Phase, RenderSettings, SamplerKind, Scene,
-    Sunward, TransmittanceEstimator, Volumes,
+    IntegratorKind, Light, LightSampling, Phase, RenderSettings, SamplerKind, Scene, Sunward,
+    Volumes,
 };
 
 /// The prepared scene the GPU backend takes: what `cirrus-scene` prepares
@@ -108,18 +108,6 @@ fn phase_refused(phase: &Phase) -> Option<&'static str> {
 /// not), in words, for the caller to say; `None` where it uses those.
 pub fn substitutions(settings: &RenderSettings) -> Option<String> {
     let mut out = Vec::new();
-    if settings.transmittance != TransmittanceEstimator::Ratio {
-        out.push(format!(
-            "ratio tracking for --transmittance {}",
-            settings.transmittance.name()
-        ));
-    }
-    if settings.majorant != MajorantMode::Hierarchy {
-        out.push(format!(
-            "one majorant level (4^3-voxel cells) for --majorant {}",
-            settings.majorant.name()
-        ));
-    }
     if settings.sampler != SamplerKind::Random {
         out.push(format!(
             "random numbers for --sampler {}",

@@ -66,7 +66,7 @@ fn white_furnace_is_one_everywhere() {
 /// expectation does not).
 #[test]
 fn gpu_agrees_with_cpu() {
-    agrees_with_cpu(
+    let stats = agrees_with_cpu(
         r#"
         [sun]
         angle = 0.53
@@ -77,6 +77,11 @@ fn gpu_agrees_with_cpu() {
         albedo = 0.9
         g = 0.6
         "#,
+    );
+    // The CPU's defaults, honoured.
+    assert_eq!(
+        (stats.majorant.as_str(), stats.transmittance.as_str()),
+        ("auto: hierarchy", "residual")
     );
 }
 
@@ -102,10 +107,89 @@ fn gpu_agrees_with_cpu_with_a_delta_sun_and_two_events() {
     );
 }
 
+/// One global majorant over the box and plain ratio tracking, both as
+/// named (the CPU's defaults are the hierarchy and residual ratio
+/// tracking): the same agreement.
+#[test]
+fn gpu_agrees_with_cpu_over_the_global_bound_by_ratio_tracking() {
+    let stats = agrees_with_cpu(
+        r#"
+        [render]
+        majorant = "global"
+        transmittance = "ratio"
+        [sun]
+        angle = 0.53
+        [environment]
+        radiance = [0.16, 0.22, 0.34]
+        [[volume]]
+        file = "cloud.vdb"
+        albedo = 0.9
+        g = 0.6
+        "#,
+    );
+    assert_eq!(
+        (stats.majorant.as_str(), stats.transmittance.as_str()),
+        ("global", "ratio")
+    );
+}
+
+/// A dense cloud (density x 40) walked over coarse cells (a cell may waste
+/// an optical depth of 6 before it is refined) and, where a finest cell is
+/// too thick for its slack, voxel by voxel; shadow rays by track-length
+/// estimation: the same agreement. The scene is checked to take both
+/// kinds of cell.
+#[test]
+fn gpu_agrees_with_cpu_on_coarse_and_voxel_cells_by_track_length() {
+    let tables = r#"
+        [render]
+        majorant = "hierarchy"
+        transmittance = "track-length"
+        refine_optical_depth = 6.0
+        [sun]
+        angle = 0
+        direction = [0.4, -0.7, -0.5]
+        [environment]
+        radiance = [0.2, 0.25, 0.3]
+        [[volume]]
+        file = "cloud.vdb"
+        density_scale = 40.0
+        albedo = 0.8
+        g = 0.3
+        "#;
+    let s = scene(tables);
+    let mut cache = cirrus_scene::VolumeCache::default();
+    let prepared = s.prepare(&mut cache, None).expect("scene prepares");
+    let field = prepared.scene.media.instances()[0].field.still_field();
+    let partition = field.partition().expect("a refined partition");
+    let coarse = partition
+        .codes()
+        .iter()
+        .filter(|&&c| c & 0x80 == 0 && c > 0)
+        .count();
+    let level0 = &field.volume().levels[0];
+    let thick = level0
+        .cells
+        .chunks_exact(2)
+        .filter(|c| (c[1] - c[0]) * 4.0 > partition.voxel_split())
+        .count();
+    assert!(
+        coarse > 0 && thick > 0,
+        "coarse cells {coarse}, thick finest cells {thick}"
+    );
+    drop(prepared);
+    let stats = agrees_with_cpu(tables);
+    assert_eq!(
+        (stats.majorant.as_str(), stats.transmittance.as_str()),
+        ("hierarchy", "track-length")
+    );
+}
+
 /// Renders the scene of `tables` (with a 16x16 camera at 64 spp) on both
-/// devices and compares 4x4-pixel blocks.
-fn agrees_with_cpu(tables: &str) {
-    let Some(gpu) = gpu() else { return };
+/// devices and compares 4x4-pixel blocks; the GPU render's statistics.
+fn agrees_with_cpu(tables: &str) -> cirrus_render::RenderStats {
+    let Some(gpu) = gpu() else {
+        return Default::default();
+    };
     let s = scene(&format!(
         r#"
         [camera]
@@ -122,8 +206,11 @@ fn agrees_with_cpu(tables: &str) {
     let gr = render_gpu(&gpu, &s).expect("GPU render");
     let c = render_cpu(&s).image;
     let counted = &gr.stats.counters;
-    assert!(counted.real_collisions > 0 && counted.shadow_collisions > 0);
+    // Track-length shadow rays are free flights: no shadow collisions.
+    assert!(counted.real_collisions > 0);
+    assert!(counted.shadow_collisions > 0 || gr.stats.transmittance == "track-length");
     assert_eq!(counted.paths, 16 * 16 * 64);
+    let stats = gr.stats;
     let g = gr.image;
     let mut worst: f64 = 0.0;
     for by in 0..4 {
@@ -146,6 +233,7 @@ fn agrees_with_cpu(tables: &str) {
     let (mean, _) = block_mean(&c, 1, (0, 0, 16, 16));
     assert!(mean > 0.05, "CPU image mean {mean}");
     eprintln!("largest block difference: {worst:.2} standard errors");
+    stats
 }
 
 /// Same seed, same settings, same device: the same bytes.

@@ -11,7 +11,7 @@
 // `collide`, `scatter_from`, `roulette`) and path_light.rs (`direct_light`,
 // `light_term`) for one grey medium lit by lights at infinity: every
 // collision scatters with the albedo as weight, every light is sampled at
-// every vertex (shadow rays by ratio tracking), phase-sampled directions
+// every vertex (shadow rays by the settings' estimator, ratio.wgsl), phase-sampled directions
 // that escape take the power heuristic against those samples, Russian
 // roulette after 3 events below a throughput of 0.1.
 
@@ -33,7 +33,7 @@ fn camera_dir(px: f32, py: f32) -> vec3<f32> {
 // its direction was phase-sampled with, 0 for a camera ray (full weight).
 fn escape_radiance(dir: vec3<f32>, pdf: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
-    for (var i = 0u; i < params.cell_dims.w; i++) {
+    for (var i = 0u; i < params.counts.x; i++) {
         iterations += 1u;
         let e = escaped_light(i, dir);
         if e.w > 0.0 {
@@ -48,7 +48,7 @@ fn escape_radiance(dir: vec3<f32>, pdf: f32) -> vec3<f32> {
 // every light, weighed against phase sampling where `mis`.
 fn direct_light(p: vec3<f32>, dir_in: vec3<f32>, mis: bool, rng: ptr<function, u32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
-    for (var i = 0u; i < params.cell_dims.w; i++) {
+    for (var i = 0u; i < params.counts.x; i++) {
         iterations += 1u;
         let u1 = random(rng);
         let u2 = random(rng);
