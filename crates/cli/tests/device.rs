@@ -127,3 +127,53 @@ fn auto_says_where_it_renders() {
     );
     assert!(d.join("a.exr").exists());
 }
+
+/// A scene file's `[render] device` chooses the device as `--device`
+/// does, and the flag overrides it; a device it does not know is refused
+/// naming the file.
+#[test]
+fn a_scene_file_chooses_the_device() {
+    let d = scratch("scene");
+    let cloud = std::fs::canonicalize("data/cloud.vdb")
+        .or_else(|_| std::fs::canonicalize("../../data/cloud.vdb"))
+        .unwrap();
+    let write = |name: &str, device: &str| {
+        let path = d.join(name);
+        std::fs::write(
+            &path,
+            format!(
+                "[render]\ndevice = \"{device}\"\nspp = 1\n[camera]\nres = \"8x6\"\n\
+                 [[volume]]\nfile = {:?}\n",
+                cloud.to_str().unwrap()
+            ),
+        )
+        .unwrap();
+        path
+    };
+    let gpu_scene = write("gpu.toml", "gpu");
+    let out = d.join("s.exr");
+    let (ok, _, err) = cirrus(&[
+        "render",
+        gpu_scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    if !no_adapter(&err) {
+        assert!(ok, "{err}");
+        assert!(err.contains("rendering on the GPU"), "{err}");
+    }
+    let (ok, _, err) = cirrus(&[
+        "render",
+        gpu_scene.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(!err.contains("GPU"), "--device cpu touched a GPU: {err}");
+    let bad = write("bad.toml", "tpu");
+    let (ok, _, err) = cirrus(&["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("bad.toml") && err.contains("device"), "{err}");
+}

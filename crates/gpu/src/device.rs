@@ -3,40 +3,6 @@
 
 use std::fmt;
 
-/// Where `cirrus render --device` runs a render.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum DeviceChoice {
-    /// The CPU, always (the default).
-    #[default]
-    Cpu,
-    /// A hardware GPU where there is one, else the CPU.
-    Auto,
-    /// A GPU adapter, a software one (lavapipe) included; an error when
-    /// there is none.
-    Gpu,
-}
-
-impl DeviceChoice {
-    pub const NAMES: [&'static str; 3] = ["cpu", "auto", "gpu"];
-
-    pub fn from_name(s: &str) -> Option<Self> {
-        match s {
-            "cpu" => Some(Self::Cpu),
-            "auto" => Some(Self::Auto),
-            "gpu" => Some(Self::Gpu),
-            _ => None,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Cpu => "cpu",
-            Self::Auto => "auto",
-            Self::Gpu => "gpu",
-        }
-    }
-}
-
 /// Why no GPU render happened.
 #[derive(Debug)]
 pub enum GpuError {

@@ -20,8 +20,8 @@
 //!   and the field's cell partition (the CPU's hierarchy walk), lights as
 //!   tagged records and one block of parameters (transform, camera,
 //!   medium, window, seed, majorants and shadow rays' estimator).
-//! - `device.rs`: the adapter ([`open`]; [`DeviceChoice`] for the command
-//!   line) and [`GpuError`].
+//! - `device.rs`: the adapter ([`open`]; the `device` setting that
+//!   chooses it is `cirrus_scene::Device`) and [`GpuError`].
 //! - `kernel.rs` and `shaders/`: the megakernel, one WGSL file a stage
 //!   (`lookup`, `walk`, `delta`, `ratio`, `lights`, `path`), each citing
 //!   the CPU code it mirrors; the scene uploaded once, one pass a sample
@@ -46,7 +46,7 @@ use cirrus_render::{
     Budget, MajorantMode, PassFilm, PixelMoments, RenderSettings, RenderStats, Rendered,
 };
 
-pub use device::{open, DeviceChoice, Gpu, GpuError, INSTALL_HINT};
+pub use device::{open, Gpu, GpuError, INSTALL_HINT};
 pub use flat::{FlatScene, LightRecord, Params, WalkChoice};
 pub use kernel::{source, PixelSlot, STAGES};
 pub use support::{substitutions, unsupported, PreparedScene};
