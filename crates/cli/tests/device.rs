@@ -54,6 +54,7 @@ fn gpu_renders_write_the_same_outputs() {
     }
     assert!(ok, "{err}");
     assert!(err.contains("rendering on the GPU"), "{err}");
+    assert!(err.contains("16x12 at 2 spp"), "{err}");
     let image = exr::prelude::read_first_rgba_layer_from_file(
         &exr,
         |res, _| vec![[0f32; 4]; res.width() * res.height()],

@@ -46,9 +46,28 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     /// The largest storage binding the device allows, in bytes.
     pub max_binding: u64,
+    /// Storage bindings a kernel may have.
+    pub max_bindings: u32,
+    /// Bytes of the device's largest device-local memory heap (`u64::MAX`
+    /// where Vulkan does not say).
+    pub memory: u64,
 }
 
 impl Gpu {
+    /// The same device as if it bound at most `bytes` a storage binding
+    /// (tests force the atlas's split with it).
+    pub fn with_binding_limit(mut self, bytes: u64) -> Self {
+        self.max_binding = self.max_binding.min(bytes);
+        self
+    }
+
+    /// The same device as if it had `bytes` of memory (tests force the
+    /// refusal of a scene too large with it).
+    pub fn with_memory_limit(mut self, bytes: u64) -> Self {
+        self.memory = self.memory.min(bytes);
+        self
+    }
+
     /// Whether the adapter is a GPU in hardware (not lavapipe or another
     /// software rasteriser).
     pub fn is_hardware(&self) -> bool {
@@ -57,8 +76,12 @@ impl Gpu {
 
     /// The adapter in words, for messages: its name and kind.
     pub fn describe(&self) -> String {
+        let memory = match self.memory {
+            u64::MAX => String::new(),
+            bytes => format!(", {} MiB", bytes >> 20),
+        };
         format!(
-            "{} ({:?}, {:?})",
+            "{} ({:?}, {:?}{memory})",
             self.info.name, self.info.device_type, self.info.backend
         )
     }
@@ -96,6 +119,7 @@ pub fn open(software: bool) -> Result<Gpu, GpuError> {
     };
     // All the adapter allows: the largest bindings (a volume's atlas) above all.
     let limits = adapter.limits();
+    let memory = device_memory(&adapter);
     let (device, queue) = block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         label: Some("cirrus"),
         required_limits: limits.clone(),
@@ -109,7 +133,34 @@ pub fn open(software: bool) -> Result<Gpu, GpuError> {
         max_binding: limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size),
+        max_bindings: limits.max_storage_buffers_per_shader_stage,
+        memory,
     })
+}
+
+/// The size of the adapter's largest device-local memory heap, which
+/// every buffer of a render must fit in (wgpu does not say; Vulkan does).
+fn device_memory(adapter: &wgpu::Adapter) -> u64 {
+    // Vulkan's VK_MEMORY_HEAP_DEVICE_LOCAL_BIT.
+    const DEVICE_LOCAL: u32 = 1;
+    // SAFETY: the adapter is a Vulkan one (the instance has no other
+    // backend) and outlives the call; the query reads properties only.
+    let heaps = unsafe {
+        adapter.as_hal::<wgpu::hal::api::Vulkan>().map(|hal| {
+            let instance = hal.shared_instance().raw_instance();
+            let props = instance.get_physical_device_memory_properties(hal.raw_physical_device());
+            props.memory_heaps[..props.memory_heap_count as usize]
+                .iter()
+                .filter(|h| h.flags.as_raw() & DEVICE_LOCAL != 0)
+                .map(|h| h.size)
+                .max()
+                .unwrap_or(0)
+        })
+    };
+    match heaps {
+        Some(bytes) if bytes > 0 => bytes,
+        _ => u64::MAX,
+    }
 }
 
 /// Runs a future to completion on this thread: wgpu's native futures are

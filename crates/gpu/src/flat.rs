@@ -5,7 +5,8 @@
 //!
 //! - `map`: the brick map, one `tag:2 | index:30` word a brick, x-major
 //!   (`crates/bricks/src/layout.rs`).
-//! - `atlas`: stored bricks' voxels as u32 words: f32 bits one a word, or
+//! - `atlas`: stored bricks' voxels as u32 words (uploaded in chunks of
+//!   whole bricks, one a binding, as large as a binding may be): f32 bits one a word, or
 //!   two f16 a word (the lower half the even voxel), 512 voxels a brick.
 //! - `constants`: constant bricks' values.
 //! - `pyramid`: every level of the bounds pyramid
@@ -50,7 +51,7 @@ pub struct Params {
     pub phase: [f32; 4],
     /// Bricks per axis (xyz), atlas precision (w: 0 f32, 1 f16).
     pub map_dims: [u32; 4],
-    /// Light count (x).
+    /// Light count (x), stored bricks per atlas chunk (y, set at upload).
     pub counts: [u32; 4],
     /// Full image width and height, window origin x0, y0.
     pub image: [u32; 4],
@@ -195,11 +196,28 @@ impl FlatScene {
         }
     }
 
-    /// Bytes of the largest array (what a storage binding must hold).
+    /// Words of one stored brick in the atlas (512 f32, or 256 pairs of
+    /// f16).
+    pub fn brick_words(&self) -> usize {
+        if self.params.map_dims[3] == 1 {
+            256
+        } else {
+            512
+        }
+    }
+
+    /// Bytes of every array uploaded.
+    pub fn bytes(&self) -> u64 {
+        let lights = self.lights.len() * std::mem::size_of::<LightRecord>();
+        let words = self.map.len() + self.atlas.len() + self.constants.len() + self.pyramid.len();
+        (4 * (words + self.partition.len()) + lights + std::mem::size_of::<Params>()) as u64
+    }
+
+    /// Bytes of the largest array but the atlas (which is split over as
+    /// many bindings as it needs): what one storage binding must hold.
     pub fn largest_binding(&self) -> u64 {
         [
             self.map.len() * 4,
-            self.atlas.len() * 4,
             self.constants.len() * 4,
             self.pyramid.len() * 4,
             self.partition.len() * 4,

@@ -320,3 +320,70 @@ fn an_empty_volume_shows_the_sky() {
         assert_eq!(*p, [0.25, 0.5, 1.0, 0.0]);
     }
 }
+
+/// An atlas larger than a binding is split over several, whole bricks a
+/// chunk: forced here with a binding limit a third of the cloud's atlas,
+/// the image is the unsplit one's, bit for bit (the same numbers read from
+/// other buffers).
+#[test]
+fn a_split_atlas_renders_the_same_bytes() {
+    let Some(gpu) = gpu() else { return };
+    let s = scene(
+        r#"
+        [render]
+        spp = 2
+        seed = 4
+        [camera]
+        res = "16x12"
+        [[volume]]
+        file = "cloud.vdb"
+        "#,
+    );
+    let whole = render_gpu(&gpu, &s).expect("GPU render").image;
+    let mut cache = cirrus_scene::VolumeCache::default();
+    let prepared = s.prepare(&mut cache, None).expect("scene prepares");
+    let volume = prepared.scene.media.instances()[0]
+        .field
+        .still_field()
+        .volume();
+    let atlas_bytes = volume.atlas().bytes() as u64;
+    drop(prepared);
+    let limit = atlas_bytes / 3 + 1;
+    let split = render_gpu(&gpu.with_binding_limit(limit), &s)
+        .expect("GPU render, split")
+        .image;
+    assert!(
+        atlas_bytes > 2 * 4096,
+        "a tiny atlas ({atlas_bytes} bytes) proves nothing"
+    );
+    let bits = |i: &cirrus_render::Image| -> Vec<u32> {
+        i.rgba.iter().flatten().map(|v| v.to_bits()).collect()
+    };
+    assert_eq!(bits(&whole), bits(&split));
+}
+
+/// A scene whose buffers exceed the device's memory is refused before
+/// anything is uploaded, with the size it needs (forced with a 1 MiB
+/// device).
+#[test]
+fn a_scene_larger_than_the_device_is_refused_with_its_size() {
+    let Some(gpu) = gpu() else { return };
+    let s = scene(
+        r#"
+        [camera]
+        res = "8x8"
+        [[volume]]
+        file = "cloud.vdb"
+        "#,
+    );
+    let err = render_gpu(&gpu.with_memory_limit(1 << 20), &s)
+        .err()
+        .expect("a 1 MiB device renders the cloud")
+        .to_string();
+    assert!(
+        err.contains("the scene needs")
+            && err.contains("MiB on the device")
+            && err.contains("the device has 1 MiB"),
+        "{err}"
+    );
+}

@@ -17,7 +17,7 @@ struct Params {
     extent: vec4<f32>,
     phase: vec4<f32>,
     map_dims: vec4<u32>,
-    // Lights (x).
+    // Lights (x), stored bricks per atlas chunk (y).
     counts: vec4<u32>,
     image: vec4<u32>,
     window: vec4<u32>,
@@ -80,7 +80,10 @@ struct PathState {
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> brick_map: array<u32>;
-@group(0) @binding(2) var<storage, read> atlas: array<u32>;
+// The atlas's first chunk; the others (`atlas_1`, ...: bindings 10 on)
+// and `atlas_word`, which reads any, are written by the host for the
+// chunks a scene needs (kernel.rs, `atlas_chunks_source`).
+@group(0) @binding(2) var<storage, read> atlas_0: array<u32>;
 @group(0) @binding(3) var<storage, read> constants: array<f32>;
 // The bounds pyramid: (min, max) pairs, level after level.
 @group(0) @binding(4) var<storage, read> pyramid: array<f32>;
