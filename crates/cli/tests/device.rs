@@ -79,18 +79,18 @@ fn gpu_refuses_what_it_does_not_render_by_name() {
         "data/cloud.vdb",
         "--device",
         "gpu",
-        "--phase",
-        "rayleigh",
+        "--integrator",
+        "raymarch",
         "--res",
         "8x8",
         "-o",
         d.join("r.exr").to_str().unwrap(),
     ]);
-    assert!(!ok, "a Rayleigh scene rendered on the GPU: {err}");
+    assert!(!ok, "a ray-marched scene rendered on the GPU: {err}");
     if no_adapter(&err) {
         return;
     }
-    assert!(err.contains("the Rayleigh phase function"), "{err}");
+    assert!(err.contains("the raymarch integrator"), "{err}");
     assert!(err.contains("use --device cpu"), "{err}");
     assert!(!d.join("r.exr").exists(), "an image was written");
 }

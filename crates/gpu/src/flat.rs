@@ -47,8 +47,11 @@ pub struct Params {
     pub albedo: [f32; 4],
     /// Local extent of the brick grid in voxels (xyz).
     pub extent: [f32; 4],
-    /// HG g (x).
+    /// The phase function's first lobe: g, alpha, norm, and (w) its
+    /// weight (`shaders/phase.wgsl`).
     pub phase: [f32; 4],
+    /// Its second lobe: g, alpha, norm.
+    pub phase_b: [f32; 4],
     /// Bricks per axis (xyz), atlas precision (w: 0 f32, 1 f16).
     pub map_dims: [u32; 4],
     /// Light count (x), stored bricks per atlas chunk (y, set at upload).
@@ -150,10 +153,7 @@ impl FlatScene {
             })
             .collect();
         let pd = partition.dims();
-        let g = match &medium.phase {
-            Phase::Hg(h) => h.g(),
-            _ => 0.0,
-        };
+        let (phase, phase_b) = phase_lobes(&medium.phase);
         let (atlas, precision) = atlas_words(volume.atlas());
         let lights: Vec<LightRecord> = lights.iter().filter_map(light_record).collect();
         let extent = volume.local_extent();
@@ -166,7 +166,8 @@ impl FlatScene {
                 medium.density_scale,
             ],
             extent: [extent.x, extent.y, extent.z, 0.0],
-            phase: [g, 0.0, 0.0, 0.0],
+            phase,
+            phase_b,
             map_dims: [volume.dims[0], volume.dims[1], volume.dims[2], precision],
             counts: [lights.len() as u32, 0, 0, 0],
             walk: [
@@ -227,6 +228,35 @@ impl FlatScene {
         .max()
         .unwrap_or(0) as u64
     }
+}
+
+/// A Draine lobe `(g, alpha, norm, 0)`: HG at alpha 0 (draine.rs's
+/// normaliser, in f64 as there).
+fn lobe(g: f32, alpha: f32) -> [f32; 4] {
+    let (g64, a64) = (f64::from(g), f64::from(alpha));
+    let norm = 1.0 / (1.0 + a64 * (1.0 + 2.0 * g64 * g64) / 3.0);
+    [g, alpha, norm as f32, 0.0]
+}
+
+/// `phase` as a blend of two Draine lobes (`shaders/phase.wgsl`), the
+/// first's weight in its `w`: every phase function but a table (refused
+/// before flattening, `support.rs`; it takes HG with g 0 here).
+pub fn phase_lobes(phase: &Phase) -> ([f32; 4], [f32; 4]) {
+    let (a, b, w) = match phase {
+        Phase::Hg(h) => (lobe(h.g(), 0.0), lobe(0.0, 0.0), 1.0),
+        Phase::TwoHg(blend) => {
+            let (a, b) = blend.lobes();
+            (lobe(a.g(), 0.0), lobe(b.g(), 0.0), blend.weight())
+        }
+        Phase::Draine(d) => (lobe(d.g(), d.alpha()), lobe(0.0, 0.0), 1.0),
+        Phase::HgDraine(blend) => {
+            let (a, b) = blend.lobes();
+            (lobe(a.g(), 0.0), lobe(b.g(), b.alpha()), blend.weight())
+        }
+        Phase::Rayleigh(_) => (lobe(0.0, 1.0), lobe(0.0, 0.0), 1.0),
+        Phase::Table(_) => (lobe(0.0, 0.0), lobe(0.0, 0.0), 1.0),
+    };
+    ([a[0], a[1], a[2], w], b)
 }
 
 fn walk_mode(mode: MajorantMode) -> u32 {

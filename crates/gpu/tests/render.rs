@@ -12,14 +12,27 @@ use common::{block_mean, gpu, render_cpu, render_gpu, scene};
 /// function (g = 0.8) make the paths long.
 #[test]
 fn white_furnace_is_one_everywhere() {
+    furnace("g = 0.8", 24, 16);
+}
+
+/// The same furnace under the approximate Mie fit (an HG lobe and a
+/// Draine lobe, the latter drawn by rejection).
+#[test]
+fn white_furnace_is_one_under_mie_scattering() {
+    furnace("phase = \"mie\"\n        droplet_diameter = 12.0", 16, 12);
+}
+
+/// Renders the furnace with `phase` at `res` x `res` and `spp`, and checks
+/// every channel's image mean is 1 within 4 standard errors.
+fn furnace(phase: &str, res: u32, spp: u32) {
     let Some(gpu) = gpu() else { return };
-    let s = scene(
+    let s = scene(&format!(
         r#"
         [render]
-        spp = 16
+        spp = {spp}
         seed = 3
         [camera]
-        res = "24x24"
+        res = "{res}x{res}"
         [sun]
         enabled = false
         [environment]
@@ -28,12 +41,12 @@ fn white_furnace_is_one_everywhere() {
         file = "cloud.vdb"
         density_scale = 20.0
         albedo = 1.0
-        g = 0.8
-        "#,
-    );
+        {phase}
+        "#
+    ));
     let r = render_gpu(&gpu, &s).expect("GPU render");
     let image = &r.image;
-    assert_eq!((image.width, image.height, image.spp), (24, 24, 16));
+    assert_eq!((image.width, image.height, image.spp), (res, res, spp));
     assert!(
         image.rgba.iter().flatten().all(|v| v.is_finite()),
         "a pixel is not finite"
@@ -46,11 +59,11 @@ fn white_furnace_is_one_everywhere() {
     // The cloud must be in view, or the test would prove nothing: a
     // fifth of the camera rays collide in the framed brick grid (alpha is
     // the track-length estimate of 1 - T).
-    let (alpha, _) = block_mean(image, 3, (0, 0, 24, 24));
+    let (alpha, _) = block_mean(image, 3, (0, 0, res, res));
     assert!(alpha > 0.15, "the cloud covers {alpha} of the image");
     for c in 0..3 {
-        let (mean, se) = block_mean(image, c, (0, 0, 24, 24));
-        eprintln!("furnace channel {c}: {mean} +- {se}");
+        let (mean, se) = block_mean(image, c, (0, 0, res, res));
+        eprintln!("furnace ({phase}) channel {c}: {mean} +- {se}");
         assert!(se > 0.0, "channel {c}: no noise at all");
         assert!(
             (mean - 1.0).abs() < 4.0 * se,
@@ -103,6 +116,48 @@ fn gpu_agrees_with_cpu_with_a_delta_sun_and_two_events() {
         file = "cloud.vdb"
         albedo = [0.95, 0.8, 0.6]
         g = -0.3
+        "#,
+    );
+}
+
+/// The approximate Mie fit of 8 um droplets (HG g 0.98 and a Draine
+/// lobe) under a delta sun, whose NEE sees the phase function's forward
+/// peak and glory: the same agreement.
+#[test]
+fn gpu_agrees_with_cpu_under_mie_scattering() {
+    agrees_with_cpu(
+        r#"
+        [sun]
+        angle = 0
+        direction = [0.5, -0.3, -0.8]
+        [environment]
+        radiance = [0.1, 0.12, 0.2]
+        [[volume]]
+        file = "cloud.vdb"
+        albedo = 0.95
+        phase = "mie"
+        droplet_diameter = 8.0
+        "#,
+    );
+}
+
+/// A backward Draine lobe (g -0.4, alpha 3): the same agreement.
+#[test]
+fn gpu_agrees_with_cpu_under_a_backward_draine_phase() {
+    agrees_with_cpu(
+        r#"
+        [render]
+        max_depth = 3
+        [sun]
+        angle = 0.53
+        [environment]
+        radiance = [0.2, 0.2, 0.25]
+        [[volume]]
+        file = "cloud.vdb"
+        albedo = 0.9
+        phase = "draine"
+        g = -0.4
+        draine_alpha = 3.0
         "#,
     );
 }

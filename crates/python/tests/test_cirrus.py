@@ -302,5 +302,5 @@ def test_device_chooses_where_a_render_runs(tmp_path):
     np.testing.assert_array_equal(image, exr_rgba(exr))
     cpu, _ = cirrus.render(CLOUD, device="cpu", res="16x12", spp=2, seed=5)
     assert not np.array_equal(cpu, image)
-    with pytest.raises(ValueError, match="the Rayleigh phase function"):
-        cirrus.render(CLOUD, device="gpu", res="8x8", spp=1, phase="rayleigh")
+    with pytest.raises(ValueError, match="the raymarch integrator"):
+        cirrus.render(CLOUD, device="gpu", res="8x8", spp=1, integrator="raymarch")

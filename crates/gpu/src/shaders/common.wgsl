@@ -15,7 +15,10 @@ struct Params {
     cam_up: vec4<f32>,
     albedo: vec4<f32>,
     extent: vec4<f32>,
+    // The phase function's lobes (phase.wgsl): g, alpha, norm and (w)
+    // the first lobe's weight.
     phase: vec4<f32>,
+    phase_b: vec4<f32>,
     map_dims: vec4<u32>,
     // Lights (x), stored bricks per atlas chunk (y).
     counts: vec4<u32>,
