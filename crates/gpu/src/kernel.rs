@@ -120,7 +120,7 @@ fn split_atlas(gpu: &Gpu, scene: &FlatScene) -> Result<AtlasSplit, GpuError> {
         return Err(GpuError::Device(format!(
             "the volume's atlas ({} MiB) needs {chunks} bindings of at most {} MiB and the \
              device allows {room} for it",
-            scene.atlas.len() * 4 >> 20,
+            (scene.atlas.len() * 4) >> 20,
             gpu.max_binding >> 20
         )));
     }
