@@ -64,9 +64,13 @@ for scene in thick default sky; do
   unset -n args
 done
 frame=(data/cloud.vdb --res 1920x1080 --spp 1 --device gpu)
+# A device whose bindings cannot hold a 1080p frame's paths (lavapipe's
+# 128 MiB) refuses it: said, and the other figures still printed.
 for _ in $(seq "$rounds"); do
-  "$bin" render "${frame[@]}" -o "$out/frame.exr" --stats "$out/frame.json" 2>"$out/frame.log" >/dev/null ||
-    { cat "$out/frame.log" >&2; exit 1; }
+  if ! "$bin" render "${frame[@]}" -o "$out/frame.exr" --stats "$out/frame.json" 2>"$out/frame.log" >/dev/null; then
+    echo "1920x1080 frame not timed: $(grep -v 'rendering on' "$out/frame.log" | tail -1)"
+    break
+  fi
   python3 -c "import json,sys; s=json.load(open(sys.argv[1])); print('frame gpu', s['paths'], s['wall_seconds'], s['setup_seconds'])" \
     "$out/frame.json" >>"$runs"
 done
