@@ -91,6 +91,25 @@ impl CellPartition {
 }
 
 impl CellPartition {
+    /// Level-1 cells per axis.
+    pub fn dims(&self) -> [u32; 3] {
+        self.dims
+    }
+
+    /// The table as stored, one code a level-1 cell, x-major (see the
+    /// module doc's layout): what a device walk uploads to read as this
+    /// walk does.
+    pub fn codes(&self) -> &[u8] {
+        &self.levels
+    }
+
+    /// The slack past which a level-0 cell is walked voxel by voxel.
+    pub fn voxel_split(&self) -> f32 {
+        self.voxel_split
+    }
+}
+
+impl CellPartition {
     /// The partition of a bounds pyramid (`levels`, finest first) that the
     /// walk uses when it refines cells whose slack exceeds `split` density
     /// x voxels, and walks level-0 cells whose slack exceeds `voxel_split`

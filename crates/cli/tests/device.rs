@@ -54,6 +54,7 @@ fn gpu_renders_write_the_same_outputs() {
     }
     assert!(ok, "{err}");
     assert!(err.contains("rendering on the GPU"), "{err}");
+    assert!(err.contains("16x12 at 2 spp"), "{err}");
     let image = exr::prelude::read_first_rgba_layer_from_file(
         &exr,
         |res, _| vec![[0f32; 4]; res.width() * res.height()],
@@ -78,18 +79,18 @@ fn gpu_refuses_what_it_does_not_render_by_name() {
         "data/cloud.vdb",
         "--device",
         "gpu",
-        "--phase",
-        "rayleigh",
+        "--integrator",
+        "raymarch",
         "--res",
         "8x8",
         "-o",
         d.join("r.exr").to_str().unwrap(),
     ]);
-    assert!(!ok, "a Rayleigh scene rendered on the GPU: {err}");
+    assert!(!ok, "a ray-marched scene rendered on the GPU: {err}");
     if no_adapter(&err) {
         return;
     }
-    assert!(err.contains("the Rayleigh phase function"), "{err}");
+    assert!(err.contains("the raymarch integrator"), "{err}");
     assert!(err.contains("use --device cpu"), "{err}");
     assert!(!d.join("r.exr").exists(), "an image was written");
 }
@@ -126,4 +127,54 @@ fn auto_says_where_it_renders() {
         "auto took a software adapter: {err}"
     );
     assert!(d.join("a.exr").exists());
+}
+
+/// A scene file's `[render] device` chooses the device as `--device`
+/// does, and the flag overrides it; a device it does not know is refused
+/// naming the file.
+#[test]
+fn a_scene_file_chooses_the_device() {
+    let d = scratch("scene");
+    let cloud = std::fs::canonicalize("data/cloud.vdb")
+        .or_else(|_| std::fs::canonicalize("../../data/cloud.vdb"))
+        .unwrap();
+    let write = |name: &str, device: &str| {
+        let path = d.join(name);
+        std::fs::write(
+            &path,
+            format!(
+                "[render]\ndevice = \"{device}\"\nspp = 1\n[camera]\nres = \"8x6\"\n\
+                 [[volume]]\nfile = {:?}\n",
+                cloud.to_str().unwrap()
+            ),
+        )
+        .unwrap();
+        path
+    };
+    let gpu_scene = write("gpu.toml", "gpu");
+    let out = d.join("s.exr");
+    let (ok, _, err) = cirrus(&[
+        "render",
+        gpu_scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    if !no_adapter(&err) {
+        assert!(ok, "{err}");
+        assert!(err.contains("rendering on the GPU"), "{err}");
+    }
+    let (ok, _, err) = cirrus(&[
+        "render",
+        gpu_scene.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(!err.contains("GPU"), "--device cpu touched a GPU: {err}");
+    let bad = write("bad.toml", "tpu");
+    let (ok, _, err) = cirrus(&["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("bad.toml") && err.contains("device"), "{err}");
 }

@@ -3,40 +3,6 @@
 
 use std::fmt;
 
-/// Where `cirrus render --device` runs a render.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum DeviceChoice {
-    /// The CPU, always (the default).
-    #[default]
-    Cpu,
-    /// A hardware GPU where there is one, else the CPU.
-    Auto,
-    /// A GPU adapter, a software one (lavapipe) included; an error when
-    /// there is none.
-    Gpu,
-}
-
-impl DeviceChoice {
-    pub const NAMES: [&'static str; 3] = ["cpu", "auto", "gpu"];
-
-    pub fn from_name(s: &str) -> Option<Self> {
-        match s {
-            "cpu" => Some(Self::Cpu),
-            "auto" => Some(Self::Auto),
-            "gpu" => Some(Self::Gpu),
-            _ => None,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Cpu => "cpu",
-            Self::Auto => "auto",
-            Self::Gpu => "gpu",
-        }
-    }
-}
-
 /// Why no GPU render happened.
 #[derive(Debug)]
 pub enum GpuError {
@@ -80,9 +46,28 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     /// The largest storage binding the device allows, in bytes.
     pub max_binding: u64,
+    /// Storage bindings a kernel may have.
+    pub max_bindings: u32,
+    /// Bytes of the device's largest device-local memory heap (`u64::MAX`
+    /// where Vulkan does not say).
+    pub memory: u64,
 }
 
 impl Gpu {
+    /// The same device as if it bound at most `bytes` a storage binding
+    /// (tests force the atlas's split with it).
+    pub fn with_binding_limit(mut self, bytes: u64) -> Self {
+        self.max_binding = self.max_binding.min(bytes);
+        self
+    }
+
+    /// The same device as if it had `bytes` of memory (tests force the
+    /// refusal of a scene too large with it).
+    pub fn with_memory_limit(mut self, bytes: u64) -> Self {
+        self.memory = self.memory.min(bytes);
+        self
+    }
+
     /// Whether the adapter is a GPU in hardware (not lavapipe or another
     /// software rasteriser).
     pub fn is_hardware(&self) -> bool {
@@ -91,8 +76,12 @@ impl Gpu {
 
     /// The adapter in words, for messages: its name and kind.
     pub fn describe(&self) -> String {
+        let memory = match self.memory {
+            u64::MAX => String::new(),
+            bytes => format!(", {} MiB", bytes >> 20),
+        };
         format!(
-            "{} ({:?}, {:?})",
+            "{} ({:?}, {:?}{memory})",
             self.info.name, self.info.device_type, self.info.backend
         )
     }
@@ -130,6 +119,7 @@ pub fn open(software: bool) -> Result<Gpu, GpuError> {
     };
     // All the adapter allows: the largest bindings (a volume's atlas) above all.
     let limits = adapter.limits();
+    let memory = device_memory(&adapter);
     let (device, queue) = block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         label: Some("cirrus"),
         required_limits: limits.clone(),
@@ -143,7 +133,34 @@ pub fn open(software: bool) -> Result<Gpu, GpuError> {
         max_binding: limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size),
+        max_bindings: limits.max_storage_buffers_per_shader_stage,
+        memory,
     })
+}
+
+/// The size of the adapter's largest device-local memory heap, which
+/// every buffer of a render must fit in (wgpu does not say; Vulkan does).
+fn device_memory(adapter: &wgpu::Adapter) -> u64 {
+    // Vulkan's VK_MEMORY_HEAP_DEVICE_LOCAL_BIT.
+    const DEVICE_LOCAL: u32 = 1;
+    // SAFETY: the adapter is a Vulkan one (the instance has no other
+    // backend) and outlives the call; the query reads properties only.
+    let heaps = unsafe {
+        adapter.as_hal::<wgpu::hal::api::Vulkan>().map(|hal| {
+            let instance = hal.shared_instance().raw_instance();
+            let props = instance.get_physical_device_memory_properties(hal.raw_physical_device());
+            props.memory_heaps[..props.memory_heap_count as usize]
+                .iter()
+                .filter(|h| h.flags.as_raw() & DEVICE_LOCAL != 0)
+                .map(|h| h.size)
+                .max()
+                .unwrap_or(0)
+        })
+    };
+    match heaps {
+        Some(bytes) if bytes > 0 => bytes,
+        _ => u64::MAX,
+    }
 }
 
 /// Runs a future to completion on this thread: wgpu's native futures are

@@ -5,23 +5,24 @@
 //!
 //! - `map`: the brick map, one `tag:2 | index:30` word a brick, x-major
 //!   (`crates/bricks/src/layout.rs`).
-//! - `atlas`: stored bricks' voxels as u32 words: f32 bits one a word, or
+//! - `atlas`: stored bricks' voxels as u32 words (uploaded in chunks of
+//!   whole bricks, one a binding, as large as a binding may be): f32 bits one a word, or
 //!   two f16 a word (the lower half the even voxel), 512 voxels a brick.
 //! - `constants`: constant bricks' values.
-//! - `majorants`: the maxima of one level of the bounds pyramid
-//!   (`crates/bricks/src/bounds.rs`), density units, x-major.
+//! - `pyramid`: every level of the bounds pyramid
+//!   (`crates/bricks/src/bounds.rs`), (min, max) pairs in density units,
+//!   x-major, level after level (`Params::levels` says where each starts).
+//! - `partition`: the cell partition the CPU's walk reads
+//!   (`crates/bricks/src/partition.rs`), its byte codes four to a word.
 //! - `lights`: tagged records, one a light at infinity.
 //! - `Params`: the render-to-local transform, the camera's basis, the
-//!   medium (density scale, albedo, HG g), sizes, the window, the seed.
+//!   medium (density scale, albedo, HG g), sizes, the window, the seed,
+//!   the walk's majorants and shadow rays' estimator.
 
 use bytemuck::{Pod, Zeroable};
-use cirrus_bricks::{Atlas, BrickVolume, BRICK};
-use cirrus_render::{Camera, Light, Medium, Phase};
+use cirrus_bricks::{Atlas, BrickVolume, CellPartition, MAX_LEVELS};
+use cirrus_render::{Camera, Light, MajorantMode, Medium, Phase, TransmittanceEstimator};
 use glam::Vec3;
-
-/// The level of the bounds pyramid the kernel's DDA walks: level 0, cells
-/// of 4^3 voxels, the tightest majorants the pyramid has.
-pub const MAJORANT_LEVEL: usize = 0;
 
 /// Light record tags (`shaders/lights.wgsl`).
 pub const LIGHT_SUN: u32 = 0;
@@ -44,21 +45,50 @@ pub struct Params {
     pub cam_up: [f32; 4],
     /// Albedo (xyz) and density scale (w).
     pub albedo: [f32; 4],
-    /// Local extent of the brick grid in voxels (xyz), majorant cell edge
-    /// in voxels (w).
+    /// Local extent of the brick grid in voxels (xyz).
     pub extent: [f32; 4],
-    /// HG g (x).
+    /// The phase function's first lobe: g, alpha, norm, and (w) its
+    /// weight (`shaders/phase.wgsl`).
     pub phase: [f32; 4],
+    /// Its second lobe: g, alpha, norm.
+    pub phase_b: [f32; 4],
     /// Bricks per axis (xyz), atlas precision (w: 0 f32, 1 f16).
     pub map_dims: [u32; 4],
-    /// Majorant cells per axis (xyz), light count (w).
-    pub cell_dims: [u32; 4],
+    /// Light count (x), stored bricks per atlas chunk (y, set at upload).
+    pub counts: [u32; 4],
     /// Full image width and height, window origin x0, y0.
     pub image: [u32; 4],
     /// Window width and height, first sample of the pass, samples in it.
     pub window: [u32; 4],
     /// Seed (low, high word), max depth ([`UNLIMITED_DEPTH`]: none).
     pub seed: [u32; 4],
+    /// The slack past which a finest cell is walked voxel by voxel (x),
+    /// the volume's largest density (y).
+    pub walk: [f32; 4],
+    /// Majorants (x: [`WALK_HIERARCHY`] or [`WALK_GLOBAL`]), shadow rays'
+    /// estimator (y: `TRANSMITTANCE_*`).
+    pub walk_mode: [u32; 4],
+    /// Level-1 cells of the partition per axis.
+    pub part_dims: [u32; 4],
+    /// Per pyramid level: cells per axis, its first float in `pyramid`.
+    pub levels: [[u32; 4]; MAX_LEVELS],
+}
+
+/// Majorant modes (`shaders/walk.wgsl`).
+pub const WALK_HIERARCHY: u32 = 0;
+pub const WALK_GLOBAL: u32 = 1;
+
+/// Shadow rays' estimators (`shaders/ratio.wgsl`).
+pub const TRANSMITTANCE_RATIO: u32 = 0;
+pub const TRANSMITTANCE_RESIDUAL: u32 = 1;
+pub const TRANSMITTANCE_TRACK_LENGTH: u32 = 2;
+
+/// The walk the kernel takes: majorants and shadow rays' estimator, as
+/// the settings name them (`Auto` majorants resolved by the caller).
+#[derive(Clone, Copy, Debug)]
+pub struct WalkChoice {
+    pub majorant: MajorantMode,
+    pub transmittance: TransmittanceEstimator,
 }
 
 /// One light at infinity.
@@ -80,7 +110,8 @@ pub struct FlatScene {
     pub map: Vec<u32>,
     pub atlas: Vec<u32>,
     pub constants: Vec<f32>,
-    pub majorants: Vec<f32>,
+    pub pyramid: Vec<f32>,
+    pub partition: Vec<u32>,
     pub lights: Vec<LightRecord>,
 }
 
@@ -88,28 +119,41 @@ impl FlatScene {
     /// The flat form of one medium over `volume`, placed by
     /// `local_ray` (render-space origin and direction to local ones), seen
     /// by `camera` and lit by `lights` (lights at infinity only: the
-    /// caller has refused the rest).
+    /// caller has refused the rest), walked over `partition`'s cells (the
+    /// field's own) as `walk` says.
     pub fn new<F>(
         medium: &Medium<F>,
         volume: &BrickVolume,
+        partition: &CellPartition,
         local_ray: impl Fn(Vec3, Vec3) -> (Vec3, Vec3),
         camera: &Camera,
         lights: &[Light],
+        walk: WalkChoice,
     ) -> Self {
-        // An empty volume has no pyramid: one cell of majorant 0 (its box
-        // is empty too, so no walk reaches it).
-        let (majorants, cell_dims, cell_edge) = match volume.levels.get(MAJORANT_LEVEL) {
-            Some(level) => (
-                level.cells.chunks_exact(2).map(|c| c[1]).collect(),
-                level.dims,
-                (BRICK as u32 * volume.dims[0]) as f32 / level.dims[0].max(1) as f32,
-            ),
-            None => (vec![0.0], [1, 1, 1], BRICK as f32),
-        };
-        let g = match &medium.phase {
-            Phase::Hg(h) => h.g(),
-            _ => 0.0,
-        };
+        // An empty volume has no pyramid (and an empty box: no walk
+        // reaches a cell).
+        let mut pyramid = Vec::new();
+        let mut levels = [[0u32; 4]; MAX_LEVELS];
+        for (info, level) in levels.iter_mut().zip(&volume.levels) {
+            *info = [
+                level.dims[0],
+                level.dims[1],
+                level.dims[2],
+                pyramid.len() as u32,
+            ];
+            pyramid.extend_from_slice(&level.cells);
+        }
+        let codes = partition.codes();
+        let partition_words = codes
+            .chunks(4)
+            .map(|c| {
+                c.iter()
+                    .enumerate()
+                    .fold(0u32, |w, (k, &b)| w | u32::from(b) << (8 * k))
+            })
+            .collect();
+        let pd = partition.dims();
+        let (phase, phase_b) = phase_lobes(&medium.phase);
         let (atlas, precision) = atlas_words(volume.atlas());
         let lights: Vec<LightRecord> = lights.iter().filter_map(light_record).collect();
         let extent = volume.local_extent();
@@ -121,15 +165,25 @@ impl FlatScene {
                 medium.albedo.z,
                 medium.density_scale,
             ],
-            extent: [extent.x, extent.y, extent.z, cell_edge],
-            phase: [g, 0.0, 0.0, 0.0],
+            extent: [extent.x, extent.y, extent.z, 0.0],
+            phase,
+            phase_b,
             map_dims: [volume.dims[0], volume.dims[1], volume.dims[2], precision],
-            cell_dims: [
-                cell_dims[0],
-                cell_dims[1],
-                cell_dims[2],
-                lights.len() as u32,
+            counts: [lights.len() as u32, 0, 0, 0],
+            walk: [
+                partition.voxel_split().min(f32::MAX),
+                volume.max_density(),
+                0.0,
+                0.0,
             ],
+            walk_mode: [
+                walk_mode(walk.majorant),
+                estimator(walk.transmittance),
+                0,
+                0,
+            ],
+            part_dims: [pd[0], pd[1], pd[2], 0],
+            levels,
             ..camera_params(camera)
         };
         Self {
@@ -137,23 +191,86 @@ impl FlatScene {
             map: non_empty(volume.map_words().to_vec(), 0),
             atlas: non_empty(atlas, 0),
             constants: non_empty(volume.constants().to_vec(), 0.0),
-            majorants: non_empty(majorants, 0.0),
+            pyramid: non_empty(pyramid, 0.0),
+            partition: non_empty(partition_words, 0),
             lights: non_empty(lights, LightRecord::default()),
         }
     }
 
-    /// Bytes of the largest array (what a storage binding must hold).
+    /// Words of one stored brick in the atlas (512 f32, or 256 pairs of
+    /// f16).
+    pub fn brick_words(&self) -> usize {
+        if self.params.map_dims[3] == 1 {
+            256
+        } else {
+            512
+        }
+    }
+
+    /// Bytes of every array uploaded.
+    pub fn bytes(&self) -> u64 {
+        let lights = self.lights.len() * std::mem::size_of::<LightRecord>();
+        let words = self.map.len() + self.atlas.len() + self.constants.len() + self.pyramid.len();
+        (4 * (words + self.partition.len()) + lights + std::mem::size_of::<Params>()) as u64
+    }
+
+    /// Bytes of the largest array but the atlas (which is split over as
+    /// many bindings as it needs): what one storage binding must hold.
     pub fn largest_binding(&self) -> u64 {
         [
             self.map.len() * 4,
-            self.atlas.len() * 4,
             self.constants.len() * 4,
-            self.majorants.len() * 4,
+            self.pyramid.len() * 4,
+            self.partition.len() * 4,
             self.lights.len() * std::mem::size_of::<LightRecord>(),
         ]
         .into_iter()
         .max()
         .unwrap_or(0) as u64
+    }
+}
+
+/// A Draine lobe `(g, alpha, norm, 0)`: HG at alpha 0 (draine.rs's
+/// normaliser, in f64 as there).
+fn lobe(g: f32, alpha: f32) -> [f32; 4] {
+    let (g64, a64) = (f64::from(g), f64::from(alpha));
+    let norm = 1.0 / (1.0 + a64 * (1.0 + 2.0 * g64 * g64) / 3.0);
+    [g, alpha, norm as f32, 0.0]
+}
+
+/// `phase` as a blend of two Draine lobes (`shaders/phase.wgsl`), the
+/// first's weight in its `w`: every phase function but a table (refused
+/// before flattening, `support.rs`; it takes HG with g 0 here).
+pub fn phase_lobes(phase: &Phase) -> ([f32; 4], [f32; 4]) {
+    let (a, b, w) = match phase {
+        Phase::Hg(h) => (lobe(h.g(), 0.0), lobe(0.0, 0.0), 1.0),
+        Phase::TwoHg(blend) => {
+            let (a, b) = blend.lobes();
+            (lobe(a.g(), 0.0), lobe(b.g(), 0.0), blend.weight())
+        }
+        Phase::Draine(d) => (lobe(d.g(), d.alpha()), lobe(0.0, 0.0), 1.0),
+        Phase::HgDraine(blend) => {
+            let (a, b) = blend.lobes();
+            (lobe(a.g(), 0.0), lobe(b.g(), b.alpha()), blend.weight())
+        }
+        Phase::Rayleigh(_) => (lobe(0.0, 1.0), lobe(0.0, 0.0), 1.0),
+        Phase::Table(_) => (lobe(0.0, 0.0), lobe(0.0, 0.0), 1.0),
+    };
+    ([a[0], a[1], a[2], w], b)
+}
+
+fn walk_mode(mode: MajorantMode) -> u32 {
+    match mode {
+        MajorantMode::Global => WALK_GLOBAL,
+        MajorantMode::Hierarchy | MajorantMode::Auto => WALK_HIERARCHY,
+    }
+}
+
+fn estimator(e: TransmittanceEstimator) -> u32 {
+    match e {
+        TransmittanceEstimator::Ratio => TRANSMITTANCE_RATIO,
+        TransmittanceEstimator::Residual => TRANSMITTANCE_RESIDUAL,
+        TransmittanceEstimator::TrackLength => TRANSMITTANCE_TRACK_LENGTH,
     }
 }
 

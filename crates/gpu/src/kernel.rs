@@ -12,12 +12,13 @@ use crate::flat::{FlatScene, Params};
 
 /// The kernel's stages, in the order they are joined (WGSL declarations
 /// may come in any order; this is the order to read them in).
-pub const STAGES: [(&str, &str); 7] = [
+pub const STAGES: [(&str, &str); 8] = [
     ("common.wgsl", include_str!("shaders/common.wgsl")),
     ("lookup.wgsl", include_str!("shaders/lookup.wgsl")),
     ("walk.wgsl", include_str!("shaders/walk.wgsl")),
     ("delta.wgsl", include_str!("shaders/delta.wgsl")),
     ("ratio.wgsl", include_str!("shaders/ratio.wgsl")),
+    ("phase.wgsl", include_str!("shaders/phase.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     ("path.wgsl", include_str!("shaders/path.wgsl")),
 ];
@@ -28,13 +29,35 @@ pub const ENTRY: &str = "render_pass";
 /// Pixels a workgroup covers per axis (`@workgroup_size(8, 8, 1)`).
 const GROUP: u32 = 8;
 
-/// The WGSL module: every stage, joined.
-pub fn source() -> String {
-    STAGES
-        .iter()
-        .map(|(_, s)| *s)
-        .collect::<Vec<_>>()
-        .join("\n")
+/// Storage bindings besides the atlas's chunks (`common.wgsl`).
+const OTHER_STORAGE_BINDINGS: u32 = 8;
+
+/// The binding of the atlas's second chunk (the first is binding 2).
+const FIRST_EXTRA_CHUNK_BINDING: u32 = 10;
+
+/// The WGSL module for an atlas in `chunks` bindings: every stage, joined,
+/// and the chunks' declarations.
+pub fn source(chunks: u32) -> String {
+    let mut s: Vec<String> = STAGES.iter().map(|(_, s)| s.to_string()).collect();
+    s.push(atlas_chunks_source(chunks));
+    s.join("\n")
+}
+
+/// The atlas's chunks past the first (`atlas_1`, ...) and `atlas_word`,
+/// word `i` of chunk `chunk`: a switch, as WGSL has no arrays of storage
+/// buffers without an extension.
+fn atlas_chunks_source(chunks: u32) -> String {
+    let mut s = String::from("// Written by kernel.rs (`atlas_chunks_source`).\n");
+    for k in 1..chunks {
+        let binding = FIRST_EXTRA_CHUNK_BINDING + k - 1;
+        s += &format!("@group(0) @binding({binding}) var<storage, read> atlas_{k}: array<u32>;\n");
+    }
+    s += "fn atlas_word(chunk: u32, i: u32) -> u32 {\n    switch chunk {\n";
+    for k in 1..chunks {
+        s += &format!("        case {k}u: {{\n            return atlas_{k}[i];\n        }}\n");
+    }
+    s += "        default: {\n            return atlas_0[i];\n        }\n    }\n}\n";
+    s
 }
 
 /// One pixel's running moments on the device (`PixelSlot` in
@@ -62,24 +85,73 @@ const PATH_STATE_BYTES: u64 = 80;
 struct Buffers {
     params: wgpu::Buffer,
     map: wgpu::Buffer,
-    atlas: wgpu::Buffer,
+    /// The atlas's chunks, whole bricks each.
+    atlas: Vec<wgpu::Buffer>,
     constants: wgpu::Buffer,
-    majorants: wgpu::Buffer,
+    pyramid: wgpu::Buffer,
     lights: wgpu::Buffer,
     film: wgpu::Buffer,
     paths: wgpu::Buffer,
     pending: wgpu::Buffer,
+    partition: wgpu::Buffer,
 }
 
-/// Refuses a scene or window whose arrays exceed what a binding holds.
+/// How the atlas is split: stored bricks a chunk, and chunks.
+#[derive(Clone, Copy, Debug)]
+struct AtlasSplit {
+    bricks_per_chunk: u64,
+    chunks: u32,
+}
+
+/// The atlas in chunks of as many whole bricks as a binding holds.
+fn split_atlas(gpu: &Gpu, scene: &FlatScene) -> Result<AtlasSplit, GpuError> {
+    let brick_bytes = 4 * scene.brick_words() as u64;
+    let bricks = (scene.atlas.len() as u64).div_ceil(scene.brick_words() as u64);
+    let bricks_per_chunk = (gpu.max_binding / brick_bytes).min(u64::from(u32::MAX));
+    if bricks_per_chunk == 0 {
+        return Err(GpuError::Device(format!(
+            "the device binds at most {} bytes, less than a brick ({brick_bytes})",
+            gpu.max_binding
+        )));
+    }
+    let chunks = bricks.div_ceil(bricks_per_chunk).max(1);
+    let room = u64::from(gpu.max_bindings.saturating_sub(OTHER_STORAGE_BINDINGS));
+    if chunks > room {
+        return Err(GpuError::Device(format!(
+            "the volume's atlas ({} MiB) needs {chunks} bindings of at most {} MiB and the \
+             device allows {room} for it",
+            (scene.atlas.len() * 4) >> 20,
+            gpu.max_binding >> 20
+        )));
+    }
+    Ok(AtlasSplit {
+        bricks_per_chunk,
+        chunks: chunks as u32,
+    })
+}
+
+/// Refuses a scene or window whose arrays exceed what a binding holds or
+/// whose buffers together exceed the device's memory, before anything is
+/// uploaded.
 fn check_sizes(gpu: &Gpu, scene: &FlatScene, pixels: u64) -> Result<(), GpuError> {
     let largest = scene.largest_binding();
     if largest > gpu.max_binding {
         return Err(GpuError::Device(format!(
-            "the volume needs a {} MiB array and the device binds at most {} MiB \
-             (splitting the atlas is not done yet)",
+            "the volume needs a {} MiB array besides its atlas and the device binds at most \
+             {} MiB",
             largest >> 20,
             gpu.max_binding >> 20
+        )));
+    }
+    // The film twice (on the device, and read back), and the paths.
+    let film_bytes = pixels * std::mem::size_of::<PixelSlot>() as u64;
+    let needed = scene.bytes() + 2 * film_bytes + pixels * PATH_STATE_BYTES;
+    if needed > gpu.memory {
+        return Err(GpuError::Device(format!(
+            "the scene needs {} MiB on the device ({} MiB of volume) and the device has {} MiB",
+            needed.div_ceil(1 << 20),
+            scene.bytes().div_ceil(1 << 20),
+            gpu.memory >> 20
         )));
     }
     // The paths under way are the larger per-pixel array.
@@ -95,7 +167,7 @@ fn check_sizes(gpu: &Gpu, scene: &FlatScene, pixels: u64) -> Result<(), GpuError
 }
 
 /// The scene uploaded, the film zeroed and the paths' room made.
-fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64) -> Buffers {
+fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64, split: AtlasSplit) -> Buffers {
     use wgpu::BufferUsages as U;
     let init = |label: &str, bytes: &[u8], usage: U| {
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -113,6 +185,15 @@ fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64) -> Buffers {
         })
     };
     let film = vec![PixelSlot::default(); pixels as usize];
+    let chunk_words = split.bricks_per_chunk as usize * scene.brick_words();
+    let mut atlas: Vec<wgpu::Buffer> = scene
+        .atlas
+        .chunks(chunk_words)
+        .map(|c| init("atlas", bytemuck::cast_slice(c), U::STORAGE))
+        .collect();
+    if atlas.is_empty() {
+        atlas.push(init("atlas", bytemuck::cast_slice(&[0u32]), U::STORAGE));
+    }
     Buffers {
         params: init(
             "params",
@@ -120,15 +201,16 @@ fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64) -> Buffers {
             U::UNIFORM | U::COPY_DST,
         ),
         map: init("brick map", bytemuck::cast_slice(&scene.map), U::STORAGE),
-        atlas: init("atlas", bytemuck::cast_slice(&scene.atlas), U::STORAGE),
+        atlas,
         constants: init(
             "constants",
             bytemuck::cast_slice(&scene.constants),
             U::STORAGE,
         ),
-        majorants: init(
-            "majorants",
-            bytemuck::cast_slice(&scene.majorants),
+        pyramid: init("pyramid", bytemuck::cast_slice(&scene.pyramid), U::STORAGE),
+        partition: init(
+            "partition",
+            bytemuck::cast_slice(&scene.partition),
             U::STORAGE,
         ),
         lights: init("lights", bytemuck::cast_slice(&scene.lights), U::STORAGE),
@@ -162,12 +244,15 @@ impl<'g> Kernel<'g> {
         let [w, h] = [scene.params.window[0], scene.params.window[1]];
         let pixels = u64::from(w) * u64::from(h);
         check_sizes(gpu, scene, pixels)?;
+        let split = split_atlas(gpu, scene)?;
+        let mut params = scene.params;
+        params.counts[1] = split.bricks_per_chunk as u32;
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let b = upload(device, scene, pixels);
+        let b = upload(device, scene, pixels, split);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("path tracer"),
-            source: wgpu::ShaderSource::Wgsl(Cow::Owned(source())),
+            source: wgpu::ShaderSource::Wgsl(Cow::Owned(source(split.chunks))),
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("path tracer"),
@@ -177,18 +262,21 @@ impl<'g> Kernel<'g> {
             compilation_options: Default::default(),
             cache: None,
         });
-        // In the order of `common.wgsl`'s bindings.
-        let bound = [
+        // In the order of `common.wgsl`'s bindings, then the atlas's
+        // other chunks.
+        let mut bound = vec![
             &b.params,
             &b.map,
-            &b.atlas,
+            &b.atlas[0],
             &b.constants,
-            &b.majorants,
+            &b.pyramid,
             &b.lights,
             &b.film,
             &b.paths,
             &b.pending,
+            &b.partition,
         ];
+        bound.extend(&b.atlas[1..]);
         let entries: Vec<wgpu::BindGroupEntry> = bound
             .iter()
             .enumerate()
@@ -207,7 +295,7 @@ impl<'g> Kernel<'g> {
         }
         Ok(Self {
             gpu,
-            params: scene.params,
+            params,
             params_buffer: b.params,
             film: b.film,
             pending: b.pending,
@@ -308,22 +396,26 @@ mod tests {
     #[test]
     fn the_kernel_is_valid_wgsl() {
         use wgpu::naga;
-        let module = naga::front::wgsl::parse_str(&source())
-            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source())));
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::default(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source())));
-        assert!(module.entry_points.iter().any(|e| e.name == ENTRY));
+        // One chunk of atlas, and three.
+        for chunks in [1, 3] {
+            let source = source(chunks);
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::default(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+            assert!(module.entry_points.iter().any(|e| e.name == ENTRY));
+        }
     }
 
     /// The host's sizes of the device's structs are `common.wgsl`'s.
     #[test]
     fn struct_sizes_match_the_kernel() {
         use wgpu::naga;
-        let module = naga::front::wgsl::parse_str(&source()).unwrap();
+        let module = naga::front::wgsl::parse_str(&source(1)).unwrap();
         let size = |name: &str| {
             let (_, ty) = module
                 .types

@@ -1,5 +1,6 @@
 //! The path tracer on a GPU: `cirrus-kernel`'s unbiased volume path
-//! tracing (delta tracking, ratio-tracked shadow rays, next-event
+//! tracing (delta tracking over the majorant hierarchy, shadow rays by
+//! residual ratio, ratio or track-length estimation, next-event
 //! estimation with MIS, Henyey-Greenstein scattering, Russian roulette)
 //! as one WGSL compute kernel run through `wgpu` on Vulkan, for the scenes
 //! it can render exactly, and a refusal naming everything else.
@@ -11,15 +12,16 @@
 //!   or emitting media, motion, several volumes, AOVs and compositing
 //!   layers, adaptive sampling, denoising), and where it reaches the same
 //!   expectation by other estimators than the settings name
-//!   ([`substitutions`]: ratio tracking, one level of majorants, random
-//!   numbers, every light at each vertex, no sunward scattering).
+//!   ([`substitutions`]: random numbers, every light at each vertex, no sunward
+//!   scattering).
 //! - `flat.rs`: the prepared scene `cirrus-scene` makes for every render
 //!   (the [`PreparedScene`]) as flat arrays ([`FlatScene`]): the brick
-//!   map, the atlas as u32 words, the constant bricks, one level of the
-//!   majorant pyramid, lights as tagged records and one block of
-//!   parameters (transform, camera, medium, window, seed).
-//! - `device.rs`: the adapter ([`open`]; [`DeviceChoice`] for the command
-//!   line) and [`GpuError`].
+//!   map, the atlas as u32 words, the constant bricks, the bounds pyramid
+//!   and the field's cell partition (the CPU's hierarchy walk), lights as
+//!   tagged records and one block of parameters (transform, camera,
+//!   medium, window, seed, majorants and shadow rays' estimator).
+//! - `device.rs`: the adapter ([`open`]; the `device` setting that
+//!   chooses it is `cirrus_scene::Device`) and [`GpuError`].
 //! - `kernel.rs` and `shaders/`: the megakernel, one WGSL file a stage
 //!   (`lookup`, `walk`, `delta`, `ratio`, `lights`, `path`), each citing
 //!   the CPU code it mirrors; the scene uploaded once, one pass a sample
@@ -40,10 +42,12 @@ mod support;
 
 use std::time::Instant;
 
-use cirrus_render::{Budget, PassFilm, PixelMoments, RenderSettings, RenderStats, Rendered};
+use cirrus_render::{
+    Budget, MajorantMode, PassFilm, PixelMoments, RenderSettings, RenderStats, Rendered,
+};
 
-pub use device::{open, DeviceChoice, Gpu, GpuError, INSTALL_HINT};
-pub use flat::{FlatScene, LightRecord, Params, MAJORANT_LEVEL};
+pub use device::{open, Gpu, GpuError, INSTALL_HINT};
+pub use flat::{FlatScene, LightRecord, Params, WalkChoice};
 pub use kernel::{source, PixelSlot, STAGES};
 pub use support::{substitutions, unsupported, PreparedScene};
 
@@ -63,7 +67,8 @@ pub fn render(
     }
     let mut film = PassFilm::new(&scene.camera, settings);
     let start = Instant::now();
-    let flat = flatten(scene, settings, &film);
+    let walk = walk_choice(scene, settings);
+    let flat = flatten(scene, settings, &film, walk);
     let mut kernel = kernel::Kernel::new(gpu, &flat)?;
     let setup_seconds = start.elapsed().as_secs_f64();
     let spp = match settings.budget {
@@ -94,8 +99,11 @@ pub fn render(
     film.add(&moments, spp);
     let mut stats = RenderStats {
         integrator: settings.integrator.name().into(),
-        transmittance: "ratio".into(),
-        majorant: format!("grid: level {MAJORANT_LEVEL} of the bounds pyramid"),
+        transmittance: walk.transmittance.name().into(),
+        majorant: match settings.majorant {
+            MajorantMode::Auto => format!("auto: {}", walk.majorant.name()),
+            _ => walk.majorant.name().into(),
+        },
         light_sampling: "all".into(),
         sunward: "off".into(),
         setup_seconds,
@@ -109,6 +117,15 @@ pub fn render(
     stats.counters.null_collisions = slots.iter().map(|p| u64::from(p.nulls)).sum();
     stats.counters.shadow_collisions = slots.iter().map(|p| u64::from(p.shadows)).sum();
     Ok(film.finish(stats))
+}
+
+/// The majorants and shadow rays' estimator of `settings`, as a CPU
+/// render takes them: `auto` majorants resolved by the CPU's own probe.
+fn walk_choice(scene: &PreparedScene, settings: &RenderSettings) -> WalkChoice {
+    WalkChoice {
+        majorant: cirrus_render::majorant_mode(scene, settings),
+        transmittance: settings.transmittance,
+    }
 }
 
 /// Most scattering events a dispatch advances a pixel's paths by; the
@@ -135,17 +152,34 @@ fn run_to(kernel: &mut kernel::Kernel, target: u32) -> Result<(), GpuError> {
 
 /// The flat form of `scene` for `film`'s window and `settings`' seed and
 /// depth (the caller has checked it is supported).
-fn flatten(scene: &PreparedScene, settings: &RenderSettings, film: &PassFilm) -> FlatScene {
+fn flatten(
+    scene: &PreparedScene,
+    settings: &RenderSettings,
+    film: &PassFilm,
+    walk: WalkChoice,
+) -> FlatScene {
     let medium = &scene.media.instances()[0];
     let field = medium.field.still_field();
+    // The field's own cells, as the CPU walks them; the finest where the
+    // field was made without a refinement rule (`BrickVolume::segments`).
+    let finest;
+    let partition = match field.partition() {
+        Some(p) => p,
+        None => {
+            finest = field.volume().partition(0.0, f32::INFINITY);
+            &finest
+        }
+    };
     let lights = scene.lights.clone().pruned();
     let lights: Vec<_> = lights.iter().cloned().collect();
     let mut flat = FlatScene::new(
         medium,
         field.volume(),
+        partition,
         |o, d| field.local_ray(o, d),
         &scene.camera,
         &lights,
+        walk,
     );
     let w = film.window();
     let camera = &scene.camera;

@@ -6,8 +6,8 @@ use cirrus_bricks::Precision;
 use cirrus_kernel::medium::BrickField;
 use cirrus_kernel::transform_motion::MovingField;
 use cirrus_render::{
-    IntegratorKind, Light, LightSampling, MajorantMode, Phase, RenderSettings, SamplerKind, Scene,
-    Sunward, TransmittanceEstimator, Volumes,
+    IntegratorKind, Light, LightSampling, Phase, RenderSettings, SamplerKind, Scene, Sunward,
+    Volumes,
 };
 
 /// The prepared scene the GPU backend takes: what `cirrus-scene` prepares
@@ -91,15 +91,13 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
     out
 }
 
-/// The phase functions other than Henyey-Greenstein, by name.
+/// The phase functions the kernel does not have, by name: tables (HG,
+/// two-lobe HG, Draine, the approximate Mie fit and Rayleigh are one
+/// form there, `shaders/phase.wgsl`).
 fn phase_refused(phase: &Phase) -> Option<&'static str> {
     match phase {
-        Phase::Hg(_) => None,
-        Phase::TwoHg(_) => Some("the two-lobe Henyey-Greenstein phase function"),
-        Phase::Draine(_) => Some("the Draine phase function"),
-        Phase::HgDraine(_) => Some("the approximate Mie phase function (HG + Draine)"),
-        Phase::Rayleigh(_) => Some("the Rayleigh phase function"),
         Phase::Table(_) => Some("tabulated phase functions"),
+        _ => None,
     }
 }
 
@@ -108,18 +106,6 @@ fn phase_refused(phase: &Phase) -> Option<&'static str> {
 /// not), in words, for the caller to say; `None` where it uses those.
 pub fn substitutions(settings: &RenderSettings) -> Option<String> {
     let mut out = Vec::new();
-    if settings.transmittance != TransmittanceEstimator::Ratio {
-        out.push(format!(
-            "ratio tracking for --transmittance {}",
-            settings.transmittance.name()
-        ));
-    }
-    if settings.majorant != MajorantMode::Hierarchy {
-        out.push(format!(
-            "one majorant level (4^3-voxel cells) for --majorant {}",
-            settings.majorant.name()
-        ));
-    }
     if settings.sampler != SamplerKind::Random {
         out.push(format!(
             "random numbers for --sampler {}",

@@ -12,14 +12,27 @@ use common::{block_mean, gpu, render_cpu, render_gpu, scene};
 /// function (g = 0.8) make the paths long.
 #[test]
 fn white_furnace_is_one_everywhere() {
+    furnace("g = 0.8", 24, 16);
+}
+
+/// The same furnace under the approximate Mie fit (an HG lobe and a
+/// Draine lobe, the latter drawn by rejection).
+#[test]
+fn white_furnace_is_one_under_mie_scattering() {
+    furnace("phase = \"mie\"\n        droplet_diameter = 12.0", 16, 12);
+}
+
+/// Renders the furnace with `phase` at `res` x `res` and `spp`, and checks
+/// every channel's image mean is 1 within 4 standard errors.
+fn furnace(phase: &str, res: u32, spp: u32) {
     let Some(gpu) = gpu() else { return };
-    let s = scene(
+    let s = scene(&format!(
         r#"
         [render]
-        spp = 16
+        spp = {spp}
         seed = 3
         [camera]
-        res = "24x24"
+        res = "{res}x{res}"
         [sun]
         enabled = false
         [environment]
@@ -28,12 +41,12 @@ fn white_furnace_is_one_everywhere() {
         file = "cloud.vdb"
         density_scale = 20.0
         albedo = 1.0
-        g = 0.8
-        "#,
-    );
+        {phase}
+        "#
+    ));
     let r = render_gpu(&gpu, &s).expect("GPU render");
     let image = &r.image;
-    assert_eq!((image.width, image.height, image.spp), (24, 24, 16));
+    assert_eq!((image.width, image.height, image.spp), (res, res, spp));
     assert!(
         image.rgba.iter().flatten().all(|v| v.is_finite()),
         "a pixel is not finite"
@@ -46,11 +59,11 @@ fn white_furnace_is_one_everywhere() {
     // The cloud must be in view, or the test would prove nothing: a
     // fifth of the camera rays collide in the framed brick grid (alpha is
     // the track-length estimate of 1 - T).
-    let (alpha, _) = block_mean(image, 3, (0, 0, 24, 24));
+    let (alpha, _) = block_mean(image, 3, (0, 0, res, res));
     assert!(alpha > 0.15, "the cloud covers {alpha} of the image");
     for c in 0..3 {
-        let (mean, se) = block_mean(image, c, (0, 0, 24, 24));
-        eprintln!("furnace channel {c}: {mean} +- {se}");
+        let (mean, se) = block_mean(image, c, (0, 0, res, res));
+        eprintln!("furnace ({phase}) channel {c}: {mean} +- {se}");
         assert!(se > 0.0, "channel {c}: no noise at all");
         assert!(
             (mean - 1.0).abs() < 4.0 * se,
@@ -66,7 +79,7 @@ fn white_furnace_is_one_everywhere() {
 /// expectation does not).
 #[test]
 fn gpu_agrees_with_cpu() {
-    agrees_with_cpu(
+    let stats = agrees_with_cpu(
         r#"
         [sun]
         angle = 0.53
@@ -77,6 +90,11 @@ fn gpu_agrees_with_cpu() {
         albedo = 0.9
         g = 0.6
         "#,
+    );
+    // The CPU's defaults, honoured.
+    assert_eq!(
+        (stats.majorant.as_str(), stats.transmittance.as_str()),
+        ("auto: hierarchy", "residual")
     );
 }
 
@@ -102,10 +120,131 @@ fn gpu_agrees_with_cpu_with_a_delta_sun_and_two_events() {
     );
 }
 
+/// The approximate Mie fit of 8 um droplets (HG g 0.98 and a Draine
+/// lobe) under a delta sun, whose NEE sees the phase function's forward
+/// peak and glory: the same agreement.
+#[test]
+fn gpu_agrees_with_cpu_under_mie_scattering() {
+    agrees_with_cpu(
+        r#"
+        [sun]
+        angle = 0
+        direction = [0.5, -0.3, -0.8]
+        [environment]
+        radiance = [0.1, 0.12, 0.2]
+        [[volume]]
+        file = "cloud.vdb"
+        albedo = 0.95
+        phase = "mie"
+        droplet_diameter = 8.0
+        "#,
+    );
+}
+
+/// A backward Draine lobe (g -0.4, alpha 3): the same agreement.
+#[test]
+fn gpu_agrees_with_cpu_under_a_backward_draine_phase() {
+    agrees_with_cpu(
+        r#"
+        [render]
+        max_depth = 3
+        [sun]
+        angle = 0.53
+        [environment]
+        radiance = [0.2, 0.2, 0.25]
+        [[volume]]
+        file = "cloud.vdb"
+        albedo = 0.9
+        phase = "draine"
+        g = -0.4
+        draine_alpha = 3.0
+        "#,
+    );
+}
+
+/// One global majorant over the box and plain ratio tracking, both as
+/// named (the CPU's defaults are the hierarchy and residual ratio
+/// tracking): the same agreement.
+#[test]
+fn gpu_agrees_with_cpu_over_the_global_bound_by_ratio_tracking() {
+    let stats = agrees_with_cpu(
+        r#"
+        [render]
+        majorant = "global"
+        transmittance = "ratio"
+        [sun]
+        angle = 0.53
+        [environment]
+        radiance = [0.16, 0.22, 0.34]
+        [[volume]]
+        file = "cloud.vdb"
+        albedo = 0.9
+        g = 0.6
+        "#,
+    );
+    assert_eq!(
+        (stats.majorant.as_str(), stats.transmittance.as_str()),
+        ("global", "ratio")
+    );
+}
+
+/// A dense cloud (density x 40) walked over coarse cells (a cell may waste
+/// an optical depth of 6 before it is refined) and, where a finest cell is
+/// too thick for its slack, voxel by voxel; shadow rays by track-length
+/// estimation: the same agreement. The scene is checked to take both
+/// kinds of cell.
+#[test]
+fn gpu_agrees_with_cpu_on_coarse_and_voxel_cells_by_track_length() {
+    let tables = r#"
+        [render]
+        majorant = "hierarchy"
+        transmittance = "track-length"
+        refine_optical_depth = 6.0
+        [sun]
+        angle = 0
+        direction = [0.4, -0.7, -0.5]
+        [environment]
+        radiance = [0.2, 0.25, 0.3]
+        [[volume]]
+        file = "cloud.vdb"
+        density_scale = 40.0
+        albedo = 0.8
+        g = 0.3
+        "#;
+    let s = scene(tables);
+    let mut cache = cirrus_scene::VolumeCache::default();
+    let prepared = s.prepare(&mut cache, None).expect("scene prepares");
+    let field = prepared.scene.media.instances()[0].field.still_field();
+    let partition = field.partition().expect("a refined partition");
+    let coarse = partition
+        .codes()
+        .iter()
+        .filter(|&&c| c & 0x80 == 0 && c > 0)
+        .count();
+    let level0 = &field.volume().levels[0];
+    let thick = level0
+        .cells
+        .chunks_exact(2)
+        .filter(|c| (c[1] - c[0]) * 4.0 > partition.voxel_split())
+        .count();
+    assert!(
+        coarse > 0 && thick > 0,
+        "coarse cells {coarse}, thick finest cells {thick}"
+    );
+    drop(prepared);
+    let stats = agrees_with_cpu(tables);
+    assert_eq!(
+        (stats.majorant.as_str(), stats.transmittance.as_str()),
+        ("hierarchy", "track-length")
+    );
+}
+
 /// Renders the scene of `tables` (with a 16x16 camera at 64 spp) on both
-/// devices and compares 4x4-pixel blocks.
-fn agrees_with_cpu(tables: &str) {
-    let Some(gpu) = gpu() else { return };
+/// devices and compares 4x4-pixel blocks; the GPU render's statistics.
+fn agrees_with_cpu(tables: &str) -> cirrus_render::RenderStats {
+    let Some(gpu) = gpu() else {
+        return Default::default();
+    };
     let s = scene(&format!(
         r#"
         [camera]
@@ -122,8 +261,11 @@ fn agrees_with_cpu(tables: &str) {
     let gr = render_gpu(&gpu, &s).expect("GPU render");
     let c = render_cpu(&s).image;
     let counted = &gr.stats.counters;
-    assert!(counted.real_collisions > 0 && counted.shadow_collisions > 0);
+    // Track-length shadow rays are free flights: no shadow collisions.
+    assert!(counted.real_collisions > 0);
+    assert!(counted.shadow_collisions > 0 || gr.stats.transmittance == "track-length");
     assert_eq!(counted.paths, 16 * 16 * 64);
+    let stats = gr.stats;
     let g = gr.image;
     let mut worst: f64 = 0.0;
     for by in 0..4 {
@@ -146,6 +288,7 @@ fn agrees_with_cpu(tables: &str) {
     let (mean, _) = block_mean(&c, 1, (0, 0, 16, 16));
     assert!(mean > 0.05, "CPU image mean {mean}");
     eprintln!("largest block difference: {worst:.2} standard errors");
+    stats
 }
 
 /// Same seed, same settings, same device: the same bytes.
@@ -231,4 +374,71 @@ fn an_empty_volume_shows_the_sky() {
     for p in &image.rgba {
         assert_eq!(*p, [0.25, 0.5, 1.0, 0.0]);
     }
+}
+
+/// An atlas larger than a binding is split over several, whole bricks a
+/// chunk: forced here with a binding limit a third of the cloud's atlas,
+/// the image is the unsplit one's, bit for bit (the same numbers read from
+/// other buffers).
+#[test]
+fn a_split_atlas_renders_the_same_bytes() {
+    let Some(gpu) = gpu() else { return };
+    let s = scene(
+        r#"
+        [render]
+        spp = 2
+        seed = 4
+        [camera]
+        res = "16x12"
+        [[volume]]
+        file = "cloud.vdb"
+        "#,
+    );
+    let whole = render_gpu(&gpu, &s).expect("GPU render").image;
+    let mut cache = cirrus_scene::VolumeCache::default();
+    let prepared = s.prepare(&mut cache, None).expect("scene prepares");
+    let volume = prepared.scene.media.instances()[0]
+        .field
+        .still_field()
+        .volume();
+    let atlas_bytes = volume.atlas().bytes() as u64;
+    drop(prepared);
+    let limit = atlas_bytes / 3 + 1;
+    let split = render_gpu(&gpu.with_binding_limit(limit), &s)
+        .expect("GPU render, split")
+        .image;
+    assert!(
+        atlas_bytes > 2 * 4096,
+        "a tiny atlas ({atlas_bytes} bytes) proves nothing"
+    );
+    let bits = |i: &cirrus_render::Image| -> Vec<u32> {
+        i.rgba.iter().flatten().map(|v| v.to_bits()).collect()
+    };
+    assert_eq!(bits(&whole), bits(&split));
+}
+
+/// A scene whose buffers exceed the device's memory is refused before
+/// anything is uploaded, with the size it needs (forced with a 1 MiB
+/// device).
+#[test]
+fn a_scene_larger_than_the_device_is_refused_with_its_size() {
+    let Some(gpu) = gpu() else { return };
+    let s = scene(
+        r#"
+        [camera]
+        res = "8x8"
+        [[volume]]
+        file = "cloud.vdb"
+        "#,
+    );
+    let err = render_gpu(&gpu.with_memory_limit(1 << 20), &s)
+        .err()
+        .expect("a 1 MiB device renders the cloud")
+        .to_string();
+    assert!(
+        err.contains("the scene needs")
+            && err.contains("MiB on the device")
+            && err.contains("the device has 1 MiB"),
+        "{err}"
+    );
 }

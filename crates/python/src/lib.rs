@@ -19,7 +19,7 @@ use std::time::Duration;
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{RenderControl, Rendered};
-use cirrus_scene::{Error, ErrorKind, Overrides, Scene, SceneDescription};
+use cirrus_scene::{Device, Error, ErrorKind, Overrides, RenderTarget, Scene, SceneDescription};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -200,7 +200,13 @@ fn render_watched(
     };
     let worker_control = control.clone();
     let worker = std::thread::spawn(move || {
-        let run = || scene.render_with(Some(worker_control));
+        // `device = "gpu"|"auto"` (the scene's, or the keyword's) renders
+        // where `cirrus render --device` would; the CPU is watched.
+        let device = scene.settings().map(|s| s.device).unwrap_or_default();
+        let run = || match device {
+            Device::Cpu => scene.render_with(Some(worker_control)),
+            _ => RenderTarget::open(device).and_then(|t| t.render(&scene)),
+        };
         let result = match threads {
             None => run(),
             Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {

@@ -314,3 +314,22 @@ def test_aov_layers_equal_the_cli_exr(tmp_path):
     assert np.array_equal(aovs["depth"][..., 0], c["depth.Z"])
     assert np.array_equal(aovs["samples"][..., 0], c["samples.Y"])
     assert np.all(aovs["samples"] == 2)
+
+
+def test_device_chooses_where_a_render_runs(tmp_path):
+    """``device=`` renders where ``cirrus render --device`` does: on the
+    GPU, the command line's GPU image bit for bit (same seed, same
+    device); what the GPU does not render is refused by name."""
+    exr = tmp_path / "g.exr"
+    r = cli("render", str(CLOUD), "--device", "gpu", "--res", "16x12", "--spp", "2",
+            "--seed", "5", "-o", str(exr))
+    if r.returncode != 0 and "no Vulkan adapter" in r.stderr:
+        assert "CI" not in os.environ, r.stderr
+        pytest.skip(r.stderr)
+    assert r.returncode == 0, r.stderr
+    image, _ = cirrus.render(CLOUD, device="gpu", res="16x12", spp=2, seed=5)
+    np.testing.assert_array_equal(image, exr_rgba(exr))
+    cpu, _ = cirrus.render(CLOUD, device="cpu", res="16x12", spp=2, seed=5)
+    assert not np.array_equal(cpu, image)
+    with pytest.raises(ValueError, match="the raymarch integrator"):
+        cirrus.render(CLOUD, device="gpu", res="8x8", spp=1, integrator="raymarch")

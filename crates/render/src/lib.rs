@@ -48,7 +48,7 @@ pub use control::RenderControl;
 pub use exr_read::read_env_map;
 pub use film::{AovImage, Halves, Image};
 pub use pass_film::{PassFilm, PixelMoments};
-pub use render::{render, Denoised, Rendered, Window};
+pub use render::{majorant_mode, render, Denoised, Rendered, Window};
 pub use scene::{
     fitted_tile_size, Budget, Crop, RenderSettings, Scene, DEFAULT_SEED, DEFAULT_SPP,
     DEFAULT_STEP_VOXELS, DEFAULT_TILE_SIZE, MIN_TILE_SIZE, TILES_PER_THREAD,

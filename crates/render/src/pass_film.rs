@@ -88,6 +88,10 @@ impl PassFilm {
         stats.width = image.width;
         stats.height = image.height;
         stats.spp = self.spp;
+        // Every pixel takes every pass's sample.
+        stats.spp_min = self.spp;
+        stats.spp_max = self.spp;
+        stats.spp_mean = f64::from(self.spp);
         stats.wall_seconds = self.start.elapsed().as_secs_f64();
         stats.rays_per_second = counters.paths as f64 / stats.wall_seconds.max(1e-9);
         Rendered {

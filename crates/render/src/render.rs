@@ -61,6 +61,22 @@ pub struct Window {
     pub full_height: u32,
 }
 
+/// The majorant structure a CPU render of `scene` with `settings` walks:
+/// `auto` resolved by the same probe [`render`] runs, so another backend
+/// walks what the CPU would.
+pub fn majorant_mode<M: Media>(scene: &Scene<M>, settings: &RenderSettings) -> MajorantMode {
+    let shadows = shadow_grid(&scene.media, &scene.lights, settings);
+    let lights = &scene.lights;
+    majorant_choice::choose(
+        &scene.media,
+        &scene.camera,
+        lights,
+        settings,
+        shadows.as_ref(),
+    )
+    .0
+}
+
 /// Renders `scene` with `settings` on the ambient rayon pool (install a
 /// `ThreadPool` around the call to choose the thread count).
 ///

@@ -78,7 +78,8 @@ shown_by_name!(
     TransmittanceEstimator,
     MajorantMode,
     SamplerKind,
-    VelocityUnit
+    VelocityUnit,
+    crate::device::Device
 );
 
 impl Shown for (u32, u32) {

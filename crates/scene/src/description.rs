@@ -19,6 +19,7 @@ use cirrus_render::{
 };
 
 use crate::declare::declare_settings;
+use crate::device::Device;
 use crate::error::{Error, Result};
 use crate::light_keys::LightKey;
 #[cfg(feature = "clap")]
@@ -115,6 +116,13 @@ declare_settings! {
     /// function's mean cosine is at least 0.6, where it was measured to
     /// pay.
     sunward: Sunward, flag(long, value_enum), default(Sunward::default()), example(Sunward::Off);
+    /// Where the render runs: cpu; auto (a hardware GPU where there is
+    /// one, else the CPU; a scene the GPU does not render goes to the CPU,
+    /// saying why); gpu (any Vulkan adapter, lavapipe included; an error
+    /// naming what the GPU does not render). The GPU renders the path
+    /// tracer over one volume lit by a sun and a constant sky (README, "On
+    /// a GPU").
+    device: Device, flag(long, value_enum), default(Device::Cpu), example(Device::Auto);
     /// Where light scatters along a ray: free flights and equi-angular
     /// sampling toward sphere, point and spot lights weighed by MIS (what
     /// makes a beam in fog converge), or free flights alone; `auto`

@@ -41,6 +41,7 @@ mod denoise;
 mod denoise_tiles;
 pub mod dense;
 pub mod description;
+mod device;
 mod error;
 #[cfg(feature = "clap")]
 mod flags;
@@ -70,6 +71,7 @@ pub use denoise_tiles::merge_tiles;
 #[cfg(feature = "clap")]
 pub use description::OutputFlags;
 pub use description::SceneDescription;
+pub use device::{Device, RenderTarget};
 pub use error::{Error, ErrorKind, Result};
 #[cfg(feature = "clap")]
 pub use flags::{settings_table, SceneFlags};

@@ -19,6 +19,8 @@ pub struct SceneSettings {
     pub lights: Lights,
     pub render: RenderSettings,
     pub refine_optical_depth: f32,
+    /// Where the render runs.
+    pub device: crate::device::Device,
     pub denoise: bool,
 }
 
@@ -78,6 +80,7 @@ impl SceneSettings {
             lights: crate::lights::lights(desc)?,
             render,
             refine_optical_depth: r.refine_optical_depth(),
+            device: r.device(),
             denoise: r.denoise(),
         })
     }

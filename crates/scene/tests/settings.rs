@@ -114,12 +114,14 @@ fn handed(scene: &Scene) -> String {
         Err(e) => return format!("error: {e}"),
     };
     let mut s = format!(
-        "{:?}\n{:?}\n{:?}\n{:?}\n{:?}\n",
+        "{:?}\n{:?}\n{:?}\n{:?}\n{:?}\n{:?}\n",
         p.settings,
         p.scene.camera,
         p.scene.lights,
         scene.outputs(),
-        scene.description().render.frames
+        scene.description().render.frames,
+        // Where it renders: the caller's choice of device, not the renderer's.
+        scene.settings().map(|s| s.device).ok()
     );
     use cirrus_render::{DensityField, Media};
     let b = p.scene.media.bounds();

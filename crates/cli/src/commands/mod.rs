@@ -1,5 +1,4 @@
 pub mod convert;
-pub mod device;
 pub mod info;
 pub mod merge;
 pub mod preview;

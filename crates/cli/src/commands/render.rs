@@ -5,12 +5,10 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use super::device::{parse_device, Target};
 use super::CliResult;
-use cirrus_gpu::DeviceChoice;
 use cirrus_render::Rendered;
 use cirrus_scene::frames::{has_pattern, substitute, FrameRange};
-use cirrus_scene::{OutputFlags, Overrides, Scene, SceneFlags};
+use cirrus_scene::{OutputFlags, Overrides, RenderTarget, Scene, SceneFlags};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(clap::Args)]
@@ -23,12 +21,6 @@ pub struct RenderArgs {
     /// skipped, so an interrupted sequence resumes where it stopped).
     #[arg(long)]
     pub overwrite: bool,
-    /// Where to render: cpu; auto (a hardware GPU where there is one, else
-    /// the CPU); gpu (any Vulkan adapter, lavapipe included). The GPU
-    /// renders the path tracer over one volume lit by a sun and a constant
-    /// sky, and refuses by name whatever else a scene asks for.
-    #[arg(long, default_value = "cpu", value_name = "DEVICE", value_parser = parse_device)]
-    pub device: DeviceChoice,
     /// Removed (learned path guiding); kept to say so.
     #[arg(long, hide = true, value_name = "MODE")]
     pub guiding: Option<String>,
@@ -49,20 +41,24 @@ pub fn run(args: &RenderArgs) -> CliResult {
     args.output.write_into(&mut overrides);
     let file = &args.scene.file;
     let range = frame_range(args, &overrides)?;
-    let target = Target::open(args.device)?;
     match range {
         None => {
             let scene = load(file, &overrides, None)?;
+            let target = RenderTarget::open(scene.settings()?.device)?;
             warn_unused_velocity(&scene, &overrides);
             render_one(&scene, &target, true)?;
             Ok(())
         }
         Some(range) => {
-            // A scene file that cannot be read is reported per frame.
+            // A scene file that cannot be read is reported per frame; the
+            // device is the flag's, else the first scene file's.
+            let mut device = overrides.device.unwrap_or_default();
             if let Ok(scene) = load(file, &overrides, None) {
                 outputs_tell_frames_apart(&scene, &range)?;
                 warn_unused_velocity(&scene, &overrides);
+                device = scene.settings()?.device;
             }
+            let target = RenderTarget::open(device)?;
             sequence(file, &overrides, range, args.overwrite, &target)
         }
     }
@@ -150,7 +146,7 @@ fn load(file: &Path, overrides: &Overrides, frame: Option<i64>) -> cirrus_scene:
 /// first file written.
 fn render_one(
     scene: &Scene,
-    target: &Target,
+    target: &RenderTarget,
     bar: bool,
 ) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let outputs = scene.outputs();
@@ -209,7 +205,7 @@ fn sequence(
     overrides: &Overrides,
     range: FrameRange,
     overwrite: bool,
-    target: &Target,
+    target: &RenderTarget,
 ) -> CliResult {
     let bar = ProgressBar::new(range.count());
     bar.set_style(

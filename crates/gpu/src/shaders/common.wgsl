@@ -15,12 +15,27 @@ struct Params {
     cam_up: vec4<f32>,
     albedo: vec4<f32>,
     extent: vec4<f32>,
+    // The phase function's lobes (phase.wgsl): g, alpha, norm and (w)
+    // the first lobe's weight.
     phase: vec4<f32>,
+    phase_b: vec4<f32>,
     map_dims: vec4<u32>,
-    cell_dims: vec4<u32>,
+    // Lights (x), stored bricks per atlas chunk (y).
+    counts: vec4<u32>,
     image: vec4<u32>,
     window: vec4<u32>,
     seed: vec4<u32>,
+    // The walk (walk.wgsl): the slack past which a finest cell is walked
+    // voxel by voxel (x), the volume's largest density (y).
+    walk: vec4<f32>,
+    // Majorants (x: 0 the hierarchy, 1 one global bound), shadow rays'
+    // estimator (y: ratio.wgsl's TRANSMITTANCE_*).
+    walk_mode: vec4<u32>,
+    // Level-1 cells of the partition per axis (xyz).
+    part_dims: vec4<u32>,
+    // Per pyramid level: cells per axis (xyz), its first float in
+    // `pyramid` (w).
+    levels: array<vec4<u32>, 9>,
 }
 
 struct LightRecord {
@@ -68,15 +83,21 @@ struct PathState {
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> brick_map: array<u32>;
-@group(0) @binding(2) var<storage, read> atlas: array<u32>;
+// The atlas's first chunk; the others (`atlas_1`, ...: bindings 10 on)
+// and `atlas_word`, which reads any, are written by the host for the
+// chunks a scene needs (kernel.rs, `atlas_chunks_source`).
+@group(0) @binding(2) var<storage, read> atlas_0: array<u32>;
 @group(0) @binding(3) var<storage, read> constants: array<f32>;
-@group(0) @binding(4) var<storage, read> majorants: array<f32>;
+// The bounds pyramid: (min, max) pairs, level after level.
+@group(0) @binding(4) var<storage, read> pyramid: array<f32>;
 @group(0) @binding(5) var<storage, read> lights: array<LightRecord>;
 @group(0) @binding(6) var<storage, read_write> film: array<PixelSlot>;
 @group(0) @binding(7) var<storage, read_write> paths: array<PathState>;
 // Pixels with samples left after a dispatch (an integer count: its value
 // does not depend on the order invocations add to it).
 @group(0) @binding(8) var<storage, read_write> pending: array<atomic<u32>>;
+// The cell partition's codes, a byte a level-1 cell, four to a word.
+@group(0) @binding(9) var<storage, read> cell_codes: array<u32>;
 
 // Set where a loop was left other than by its own exits: lavapipe
 // (llvmpipe) ends every loop once an invocation has run 65535 iterations

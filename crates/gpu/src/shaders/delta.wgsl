@@ -13,7 +13,7 @@ struct Flight {
 }
 
 fn free_flight(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> Flight {
-    var w = walk_start(origin, dir, rng);
+    var w = walk_start(origin, dir, false, rng);
     loop {
         iterations += 1u;
         let e = walk_next(&w, rng);
@@ -23,12 +23,14 @@ fn free_flight(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> Fl
         if e.kind == EVENT_CAPPED {
             return Flight(FLIGHT_CAPPED, 0.0);
         }
-        let xi = random(rng) * e.majorant;
-        if xi < walk_sigma(&w, e.t) {
-            real_collisions += 1u;
-            return Flight(FLIGHT_COLLISION, e.t);
+        if e.kind == EVENT_COLLISION {
+            let xi = random(rng) * w.seg_hi;
+            if xi < walk_sigma(&w, e.t) {
+                real_collisions += 1u;
+                return Flight(FLIGHT_COLLISION, e.t);
+            }
+            null_collisions += 1u;
         }
-        null_collisions += 1u;
     }
     cut_short = true;
     return Flight(FLIGHT_CAPPED, 0.0);

@@ -1,38 +1,13 @@
-// Lights at infinity and the Henyey-Greenstein phase function.
+// Lights at infinity.
 //
 // Mirrors crates/kernel/src/light/distant.rs (a delta sun, or a cone of
 // uniform radiance irradiance / solid angle), crates/kernel/src/light/dome.rs
-// (a constant sky sampled uniformly), crates/kernel/src/phase/hg.rs and
-// crates/kernel/src/sampling.rs (uniform_sphere, uniform_cone, from_local,
+// (a constant sky sampled uniformly) and crates/kernel/src/sampling.rs (uniform_sphere, uniform_cone, from_local,
 // power_heuristic).
 
 const LIGHT_SUN: u32 = 0u;
 const LIGHT_SKY: u32 = 1u;
 const UNIFORM_SPHERE_PDF: f32 = 0.0795774715459;
-
-// HG density for scattering-angle cosine `mu`, written without
-// cancellation at the peak (hg.rs, eval_cos).
-fn hg_eval(mu_in: f32) -> f32 {
-    let g = params.phase.x;
-    let mu = clamp(mu_in, -1.0, 1.0);
-    var denom: f32;
-    if g >= 0.0 {
-        denom = (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - mu);
-    } else {
-        denom = (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + mu);
-    }
-    return (1.0 - g) * (1.0 + g) / (4.0 * PI * denom * sqrt(denom));
-}
-
-// Inverts the HG CDF in `mu` (hg.rs, sample_cos).
-fn hg_sample_cos(u: f32) -> f32 {
-    let g = params.phase.x;
-    if g == 0.0 {
-        return 1.0 - 2.0 * u;
-    }
-    let s = (1.0 - g) * (1.0 + g) / (1.0 - g + 2.0 * g * u);
-    return clamp((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0);
-}
 
 // The direction (x, y, z) in a frame whose z axis is `axis` (Duff et al.
 // 2017, glam's any_orthonormal_pair).
@@ -43,15 +18,6 @@ fn from_local(axis: vec3<f32>, x: f32, y: f32, z: f32) -> vec3<f32> {
     let s = vec3<f32>(1.0 + sign * axis.x * axis.x * a, sign * b, -sign * axis.x);
     let t = vec3<f32>(b, sign + axis.y * axis.y * a, -axis.y);
     return normalize(x * s + y * t + z * axis);
-}
-
-// A phase-sampled direction (xyz) and its density (w) (phase/mod.rs, sample).
-fn phase_sample(dir_in: vec3<f32>, u1: f32, u2: f32) -> vec4<f32> {
-    let mu = hg_sample_cos(u1);
-    let sin_t = sqrt(max(1.0 - mu * mu, 0.0));
-    let phi = 2.0 * PI * u2;
-    let dir = from_local(dir_in, sin_t * cos(phi), sin_t * sin(phi), mu);
-    return vec4<f32>(dir, hg_eval(mu));
 }
 
 fn uniform_sphere(u1: f32, u2: f32) -> vec3<f32> {
@@ -88,7 +54,9 @@ struct LightSample {
 // Light `i`'s sample at a vertex reached along `dir_in`. A constant sky at
 // a vertex without MIS (the last one) is drawn from the phase function
 // (path_light.rs, sky_sample).
-fn sample_light(i: u32, dir_in: vec3<f32>, mis: bool, u1: f32, u2: f32) -> LightSample {
+fn sample_light(i: u32, dir_in: vec3<f32>, mis: bool, rng: ptr<function, u32>) -> LightSample {
+    let u1 = random(rng);
+    let u2 = random(rng);
     let l = lights[i];
     if l.tag.x == LIGHT_SUN {
         let solid_angle = l.radiance.w;
@@ -101,7 +69,7 @@ fn sample_light(i: u32, dir_in: vec3<f32>, mis: bool, u1: f32, u2: f32) -> Light
     if mis {
         return LightSample(uniform_sphere(u1, u2), l.radiance.xyz, UNIFORM_SPHERE_PDF);
     }
-    let s = phase_sample(dir_in, u1, u2);
+    let s = phase_sample(dir_in, rng);
     return LightSample(s.xyz, l.radiance.xyz, s.w);
 }
 

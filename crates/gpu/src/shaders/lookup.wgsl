@@ -20,13 +20,16 @@ fn f16_to_f32(h: u32) -> f32 {
 }
 
 // Voxel `n` of stored brick `brick`: an f32 word, or one half of a word
-// holding two f16 (the lower half the even voxel).
+// holding two f16 (the lower half the even voxel), in the atlas chunk
+// holding the brick (whole bricks a chunk, so a pair never straddles two).
 fn stored_voxel(brick: u32, n: u32) -> f32 {
-    let i = brick * 512u + n;
+    let per_chunk = params.counts.y;
+    let chunk = brick / per_chunk;
+    let i = (brick - chunk * per_chunk) * 512u + n;
     if params.map_dims.w == 1u {
-        return f16_to_f32((atlas[i >> 1u] >> ((i & 1u) * 16u)) & 0xffffu);
+        return f16_to_f32((atlas_word(chunk, i >> 1u) >> ((i & 1u) * 16u)) & 0xffffu);
     }
-    return bitcast<f32>(atlas[i]);
+    return bitcast<f32>(atlas_word(chunk, i));
 }
 
 // The voxel at local index `c` (0 outside the volume).

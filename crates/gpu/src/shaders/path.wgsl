@@ -9,9 +9,10 @@
 //
 // Mirrors crates/kernel/src/integrator/path.rs (`trace`, `escape`,
 // `collide`, `scatter_from`, `roulette`) and path_light.rs (`direct_light`,
-// `light_term`) for one grey medium lit by lights at infinity: every
+// `light_term`) for one grey medium lit by lights at infinity (its phase
+// function: phase.wgsl): every
 // collision scatters with the albedo as weight, every light is sampled at
-// every vertex (shadow rays by ratio tracking), phase-sampled directions
+// every vertex (shadow rays by the settings' estimator, ratio.wgsl), phase-sampled directions
 // that escape take the power heuristic against those samples, Russian
 // roulette after 3 events below a throughput of 0.1.
 
@@ -33,7 +34,7 @@ fn camera_dir(px: f32, py: f32) -> vec3<f32> {
 // its direction was phase-sampled with, 0 for a camera ray (full weight).
 fn escape_radiance(dir: vec3<f32>, pdf: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
-    for (var i = 0u; i < params.cell_dims.w; i++) {
+    for (var i = 0u; i < params.counts.x; i++) {
         iterations += 1u;
         let e = escaped_light(i, dir);
         if e.w > 0.0 {
@@ -48,12 +49,10 @@ fn escape_radiance(dir: vec3<f32>, pdf: f32) -> vec3<f32> {
 // every light, weighed against phase sampling where `mis`.
 fn direct_light(p: vec3<f32>, dir_in: vec3<f32>, mis: bool, rng: ptr<function, u32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
-    for (var i = 0u; i < params.cell_dims.w; i++) {
+    for (var i = 0u; i < params.counts.x; i++) {
         iterations += 1u;
-        let u1 = random(rng);
-        let u2 = random(rng);
-        let s = sample_light(i, dir_in, mis, u1, u2);
-        let f = hg_eval(dot(dir_in, s.to_light));
+        let s = sample_light(i, dir_in, mis, rng);
+        let f = phase_eval(dot(dir_in, s.to_light));
         var weight = 0.0;
         if s.pdf < 0.0 {
             weight = f;
@@ -117,9 +116,7 @@ fn advance(st: ptr<function, PathState>, rng: ptr<function, u32>) -> bool {
     if last {
         return true;
     }
-    let u1 = random(rng);
-    let u2 = random(rng);
-    let s = phase_sample(dir, u1, u2);
+    let s = phase_sample(dir, rng);
     (*st).origin = vec4<f32>(p, s.w);
     (*st).dir = vec4<f32>(s.xyz, (*st).dir.w);
     if (*st).depth >= ROULETTE_MIN_DEPTH {

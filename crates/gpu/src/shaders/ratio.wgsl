@@ -1,15 +1,48 @@
-// Ratio tracking (Novak, Selle, Jarosz 2014) for shadow rays: the product
-// of null fractions 1 - sigma_t / majorant over the tentative collisions,
-// with pbrt-v4's Russian roulette below 0.05 (q = 0.75). Mirrors
-// crates/kernel/src/tracking/ratio.rs and tracking/roulette.rs (`f32`'s
-// `null_fraction` and `roulette` in crates/kernel/src/spectrum.rs).
+// Transmittance of shadow rays, by the estimator the settings name
+// (crates/kernel/src/tracking/mod.rs, `transmittance`):
+//
+// - ratio tracking (Novak, Selle, Jarosz 2014): the product of null
+//   fractions 1 - sigma_t / majorant over the tentative collisions
+//   (tracking/ratio.rs);
+// - residual ratio tracking (ibid., section 5) with each segment's
+//   minorant as the control: exp(-minorant x length) on entering a
+//   segment, collisions at the residual rate majorant - minorant, each
+//   weighing 1 - (sigma_t - minorant) / rate (tracking/residual.rs);
+// - track-length: 1 if a delta-tracked flight escapes, else 0
+//   (tracking/track_length.rs);
+//
+// the ratio ones with pbrt-v4's Russian roulette below 0.05 (q = 0.75:
+// tracking/roulette.rs, `f32`'s `roulette` in crates/kernel/src/spectrum.rs).
 
 const TR_ROULETTE_THRESHOLD: f32 = 0.05;
 const TR_ROULETTE_Q: f32 = 0.75;
 
+const TRANSMITTANCE_RATIO: u32 = 0u;
+const TRANSMITTANCE_RESIDUAL: u32 = 1u;
+const TRANSMITTANCE_TRACK_LENGTH: u32 = 2u;
+
+// Roulette of a transmittance estimate `tr` (0: killed).
+fn tr_roulette(tr: f32, rng: ptr<function, u32>) -> f32 {
+    if tr <= 0.0 {
+        return 0.0;
+    }
+    if tr < TR_ROULETTE_THRESHOLD {
+        if random(rng) < TR_ROULETTE_Q {
+            return 0.0;
+        }
+        return tr / (1.0 - TR_ROULETTE_Q);
+    }
+    return tr;
+}
+
 // Transmittance along render-space ray (origin, dir) to infinity.
 fn transmittance(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> f32 {
-    var w = walk_start(origin, dir, rng);
+    let estimator = params.walk_mode.y;
+    if estimator == TRANSMITTANCE_TRACK_LENGTH {
+        return select(0.0, 1.0, free_flight(origin, dir, rng).kind == FLIGHT_ESCAPED);
+    }
+    let residual = estimator == TRANSMITTANCE_RESIDUAL;
+    var w = walk_start(origin, dir, residual, rng);
     var tr = 1.0;
     loop {
         iterations += 1u;
@@ -20,16 +53,19 @@ fn transmittance(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> 
         if e.kind == EVENT_CAPPED {
             return 0.0;
         }
-        shadow_collisions += 1u;
-        tr *= max(1.0 - walk_sigma(&w, e.t) / e.majorant, 0.0);
+        if e.kind == EVENT_ENTER {
+            if residual && w.seg_lo > 0.0 {
+                tr *= exp(-w.seg_lo * (w.seg_t1 - w.seg_t0));
+                tr = tr_roulette(tr, rng);
+            }
+        } else {
+            shadow_collisions += 1u;
+            let sigma = walk_sigma(&w, e.t);
+            tr *= max(1.0 - (sigma - select(0.0, w.seg_lo, residual)) / w.rate, 0.0);
+            tr = tr_roulette(tr, rng);
+        }
         if tr <= 0.0 {
             return 0.0;
-        }
-        if tr < TR_ROULETTE_THRESHOLD {
-            if random(rng) < TR_ROULETTE_Q {
-                return 0.0;
-            }
-            tr /= 1.0 - TR_ROULETTE_Q;
         }
     }
     cut_short = true;

@@ -125,6 +125,12 @@ impl<'v> BrickField<'v> {
         }
     }
 
+    /// The cells the hierarchy walk visits (`None`: the finest cells,
+    /// [`BrickVolume::segments`]).
+    pub fn partition(&self) -> Option<&CellPartition> {
+        self.partition.as_ref()
+    }
+
     /// Makes the field move with `velocity` over `shutter`: lookups at time
     /// `t` read the density at `x - v(x) t`, and the majorants come from
     /// the volume's bounds dilated by the largest displacement over the

@@ -111,7 +111,10 @@ def render(
     ``cryptomatte=True`` (written into ``output``). ``progress(done, total)`` is called about
     every 50 ms once rendering has begun; if it raises, the render stops and the exception
     propagates, as Ctrl-C does. ``threads`` sets the worker count (the
-    image is the same on any count). Outputs named by the overrides
+    image is the same on any count). ``device="cpu"|"auto"|"gpu"`` chooses
+    where it runs, as ``cirrus render --device`` (a scene file's ``[render]
+    device`` otherwise; a GPU render takes no ``progress`` and cannot be
+    stopped). Outputs named by the overrides
     (``output``, ``png``, ``stats``) or the scene file are written too.
     """
     flags = {k: _flag_value(k, v) for k, v in overrides.items()}
