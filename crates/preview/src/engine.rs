@@ -281,6 +281,8 @@ fn meta(
         "paths_per_second": a.paths_per_second(),
         "seconds": a.seconds,
         "integrator": integrator(&a.key),
+        // Where the last pass ran ("cpu", or "gpu: " and the adapter).
+        "device": a.device,
         "exposure": exposure,
         "denoised": denoised,
     })
