@@ -100,6 +100,17 @@ fn unknown_devices_are_refused() {
     let (ok, _, err) = cirrus(&["render", "data/cloud.vdb", "--device", "tpu", "-o", "x.exr"]);
     assert!(!ok);
     assert!(err.contains("cpu, auto, gpu"), "{err}");
+    // `cirrus preview` takes the same values (refused before it serves).
+    let (ok, _, err) = cirrus(&[
+        "preview",
+        "data/cloud.vdb",
+        "--device",
+        "tpu",
+        "--port",
+        "0",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("cpu, auto, gpu"), "{err}");
 }
 
 /// `auto` takes a hardware GPU or the CPU, never lavapipe, and says which.

@@ -475,22 +475,20 @@ fn the_page_moves_passes_to_the_gpu_and_they_accumulate() {
     assert_eq!(r.status, 200, "{}", r.body);
     assert_eq!(r.json()["view"]["device"], "gpu");
     let version = r.json()["version"].as_u64().unwrap();
+    // Frames of the CPU view may still arrive first; the GPU's follow.
     let m = loop {
-        match ws.read().unwrap() {
-            tungstenite::Message::Text(t) => {
-                let meta: Value = serde_json::from_str(t.as_str()).unwrap();
-                if meta["type"] == "error" {
-                    let message = meta["message"].as_str().unwrap();
-                    assert!(no_adapter(message), "{message}");
-                    p.shutdown();
-                    return;
-                }
-                let gpu_done = meta["version"].as_u64() >= Some(version) && meta["spp"] == 16;
-                if gpu_done {
-                    break meta;
-                }
-            }
-            _ => {}
+        let tungstenite::Message::Text(t) = ws.read().unwrap() else {
+            continue;
+        };
+        let meta: Value = serde_json::from_str(t.as_str()).unwrap();
+        if meta["type"] == "error" {
+            let message = meta["message"].as_str().unwrap();
+            assert!(no_adapter(message), "{message}");
+            p.shutdown();
+            return;
+        }
+        if meta["version"].as_u64() >= Some(version) && meta["spp"] == 16 {
+            break meta;
         }
     };
     let device = m["device"].as_str().unwrap();
