@@ -189,3 +189,28 @@ fn a_scene_file_chooses_the_device() {
     assert!(!ok);
     assert!(err.contains("bad.toml") && err.contains("device"), "{err}");
 }
+
+/// `cirrus preview --device gpu` without a Vulkan driver (the loader
+/// pointed at none) says what to install before it serves anything.
+#[test]
+fn preview_without_a_vulkan_driver_says_what_to_install() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cirrus"))
+        .args([
+            "preview",
+            "data/cloud.vdb",
+            "--device",
+            "gpu",
+            "--port",
+            "0",
+        ])
+        .current_dir(common::root())
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("no Vulkan adapter"), "{err}");
+    assert!(err.contains("apt-get install mesa-vulkan-drivers"), "{err}");
+    assert!(String::from_utf8_lossy(&out.stdout).is_empty(), "it served");
+}
