@@ -5,9 +5,16 @@ not map in Blender's info log (and keeps the list in `REPORTS`), renders
 through `cirrus.render` on its own thread with Blender's progress bar fed
 from cirrus's progress and Esc (`test_break`) cancelling it, then writes
 the image into the render result: Combined (RGBA; alpha is the volume's
-coverage), Depth (cirrus's sampled distance to the first scattering, 1e10
-where none) and Emit when the view layer asks for them, and cirrus's
+coverage), and what the view layer asks for: Depth (cirrus's sampled
+distance to the first scattering, 1e10 where none), Emit, and cirrus's
 albedo and direct-light layers as the passes "Albedo" and "Direct".
+
+The render runs where `scene.cirrus.device` says (Auto, CPU or GPU
+Compute, as `cirrus render --device`): the GPU renders Combined only, so
+with a pass on, Auto renders on the CPU and GPU Compute is refused. What
+the GPU refuses, or a missing Vulkan driver, is an error report naming it;
+where the render ran (and why Auto fell back to the CPU) is reported too.
+A GPU render reports no progress and finishes before Esc is seen.
 """
 
 from __future__ import annotations
@@ -16,6 +23,7 @@ import bpy
 import numpy as np
 
 from . import export
+from .properties import DEVICES
 
 # The reports of the last render, for scripts and tests (the info log has them too).
 REPORTS: list[tuple[str, str]] = []
@@ -61,6 +69,8 @@ class CirrusRenderEngine(bpy.types.RenderEngine):
         image, stats = self.run(scene, desc)
         if image is None:
             return
+        self.report_all("WARNING", [blender_words(w) for w in stats.get("warnings", [])])
+        self.report_all("INFO", [f"cirrus rendered on {device_words(stats.get('device', ''))}"])
         self.write(image, stats, w, h)
         self.update_stats("", f"cirrus: {stats['spp']} spp in {stats['wall_seconds']:.1f} s")
 
@@ -68,13 +78,11 @@ class CirrusRenderEngine(bpy.types.RenderEngine):
         import cirrus
 
         settings = scene.cirrus
-        layer = bpy.context.view_layer if bpy.context.view_layer else scene.view_layers[0]
-        aov = ["albedo", "direct"]
-        if layer.use_pass_z:
-            aov.append("depth")
-        if layer.use_pass_emit:
-            aov.append("emission")
-        options = {"spp": settings.spp, "seed": settings.seed, "aov": aov}
+        aov = [name for name, wanted in layer_passes(scene).items() if wanted]
+        device = DEVICES[settings.device]
+        options = {"spp": settings.spp, "seed": settings.seed, "device": device}
+        if aov:
+            options["aov"] = aov
         if settings.max_depth > 0:
             options["max_depth"] = settings.max_depth
 
@@ -88,13 +96,14 @@ class CirrusRenderEngine(bpy.types.RenderEngine):
         except Cancelled:
             return None, None
         except (OSError, ValueError) as e:
-            self.report_all("ERROR", [str(e)])
+            self.report_all("ERROR", [blender_words(str(e))])
             return None, None
 
     def write(self, image: np.ndarray, stats: dict, w: int, h: int) -> None:
         aovs = stats.get("aovs", {})
         for name in ("Albedo", "Direct"):
-            self.add_pass(name, 3, "RGB")
+            if name.lower() in aovs:
+                self.add_pass(name, 3, "RGB")
         result = self.begin_result(0, 0, w, h)
         layer = result.layers[0]
 
@@ -108,6 +117,30 @@ class CirrusRenderEngine(bpy.types.RenderEngine):
             put("Depth", aovs["depth"])
         if "emission" in aovs and "Emit" in layer.passes:
             put("Emit", aovs["emission"])
-        put("Albedo", aovs["albedo"])
-        put("Direct", aovs["direct"])
+        for name in ("Albedo", "Direct"):
+            if name.lower() in aovs:
+                put(name, aovs[name.lower()])
         self.end_result(result)
+
+
+def layer_passes(scene) -> dict[str, bool]:
+    """cirrus's AOV for each pass the view layer may ask for, and whether it does."""
+    layer = bpy.context.view_layer if bpy.context.view_layer else scene.view_layers[0]
+    return {
+        "depth": layer.use_pass_z,
+        "emission": layer.use_pass_emit,
+        "albedo": layer.cirrus.use_pass_albedo,
+        "direct": layer.cirrus.use_pass_direct,
+    }
+
+
+def device_words(device: str) -> str:
+    """'the GPU: <adapter>' or 'the CPU', from the stats' "cpu" or "gpu: <adapter>"."""
+    return f"the GPU: {device[5:]}" if device.startswith("gpu: ") else "the CPU"
+
+
+def blender_words(message: str) -> str:
+    """cirrus's message with its command-line advice in Blender's terms."""
+    return (message.replace("--device gpu", "Device GPU Compute")
+            .replace("use --device cpu", "set Device to CPU (Render Properties > Cirrus)")
+            .replace("AOVs", "passes other than Combined (View Layer Properties > Cirrus Passes)"))

@@ -33,7 +33,8 @@ What is mapped:
   through its centre facing the point, which cirrus does alike; the
   world's Background
   colour or an equirectangular Environment Texture, and the scene camera
-  (its matrix, field of view and clip range);
+  (its matrix, field of view and clip range; a clip start in front of
+  every volume clips nothing and is written as 0, which the GPU renders);
 - motion blur: the shutter, and the volume's velocity grid.
 
 Everything else (other objects and lamps, nodes cirrus cannot map, linked
@@ -65,6 +66,8 @@ class Export:
         self.res = res
         self.warnings: list[str] = []
         self.desc: dict = {"render": {}, "camera": {"res": f"{res[0]}x{res[1]}"}, "volume": []}
+        # Every volume's world-space box corners (for the near clip).
+        self.corners: list[mathutils.Vector] = []
 
     def warn(self, message: str) -> None:
         if message not in self.warnings:
@@ -95,6 +98,7 @@ class Export:
         self.world()
         self.camera()
         self.motion()
+        self.drop_idle_near_clip()
         if not self.desc["volume"]:
             raise ValueError("the scene has no volume object with an OpenVDB file to render")
         return self.desc
@@ -122,6 +126,15 @@ class Export:
             else:
                 self.warn(f"{obj.name}: velocity grid {data.velocity_grid!r} is not in the file")
         self.desc["volume"].append(spec)
+        # The grid's box, padded by 5% of its size a side (far more than the
+        # filter's voxel): what the volume can fill.
+        box = [mathutils.Vector(c) for c in obj.bound_box]
+        lo = mathutils.Vector([min(c[i] for c in box) for i in range(3)])
+        hi = mathutils.Vector([max(c[i] for c in box) for i in range(3)])
+        pad = 0.05 * max(hi - lo)
+        lo, hi = lo - mathutils.Vector((pad,) * 3), hi + mathutils.Vector((pad,) * 3)
+        self.corners.extend(matrix_world @ mathutils.Vector((x, y, z))
+                            for x in (lo.x, hi.x) for y in (lo.y, hi.y) for z in (lo.z, hi.z))
 
     def grid_names(self, data) -> list[str]:
         try:
@@ -370,6 +383,24 @@ class Export:
         c["matrix"] = rows(Y_UP @ cam.matrix_world.normalized())
         c["fov"] = math.degrees(2.0 * math.atan(top))
         c["clipping"] = [float(data.clip_start), float(data.clip_end)]
+
+    def drop_idle_near_clip(self) -> None:
+        """A clip start that clips no volume, written as 0: the same image,
+        and one the GPU renders (it refuses near clipping). Clipping hides
+        what lies nearer than the plane at the clip start along the view,
+        so it clips nothing when every volume's box lies past that plane
+        (the box is convex: its nearest point is a corner). Kept whenever
+        anything moves over the shutter."""
+        c = self.desc["camera"]
+        cam = self.scene.camera
+        if "clipping" not in c or "shutter" in self.desc["render"] or not self.corners:
+            return
+        m = cam.matrix_world.normalized()
+        eye = m.translation
+        forward = -(m.to_3x3() @ mathutils.Vector((0.0, 0.0, 1.0))).normalized()
+        nearest = min((p - eye).dot(forward) for p in self.corners)
+        if nearest >= c["clipping"][0]:
+            c["clipping"][0] = 0.0
 
     def motion(self) -> None:
         r = self.scene.render

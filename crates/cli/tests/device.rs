@@ -100,6 +100,17 @@ fn unknown_devices_are_refused() {
     let (ok, _, err) = cirrus(&["render", "data/cloud.vdb", "--device", "tpu", "-o", "x.exr"]);
     assert!(!ok);
     assert!(err.contains("cpu, auto, gpu"), "{err}");
+    // `cirrus preview` takes the same values (refused before it serves).
+    let (ok, _, err) = cirrus(&[
+        "preview",
+        "data/cloud.vdb",
+        "--device",
+        "tpu",
+        "--port",
+        "0",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("cpu, auto, gpu"), "{err}");
 }
 
 /// `auto` takes a hardware GPU or the CPU, never lavapipe, and says which.
@@ -177,4 +188,29 @@ fn a_scene_file_chooses_the_device() {
     let (ok, _, err) = cirrus(&["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(!ok);
     assert!(err.contains("bad.toml") && err.contains("device"), "{err}");
+}
+
+/// `cirrus preview --device gpu` without a Vulkan driver (the loader
+/// pointed at none) says what to install before it serves anything.
+#[test]
+fn preview_without_a_vulkan_driver_says_what_to_install() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cirrus"))
+        .args([
+            "preview",
+            "data/cloud.vdb",
+            "--device",
+            "gpu",
+            "--port",
+            "0",
+        ])
+        .current_dir(common::root())
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("no Vulkan adapter"), "{err}");
+    assert!(err.contains("apt-get install mesa-vulkan-drivers"), "{err}");
+    assert!(String::from_utf8_lossy(&out.stdout).is_empty(), "it served");
 }

@@ -27,6 +27,8 @@ pub struct Accumulation {
     pub paths: u64,
     /// Render time of the passes, seconds.
     pub seconds: f64,
+    /// Where the last pass ran (its stats' `device`).
+    pub device: String,
 }
 
 impl Accumulation {
@@ -43,6 +45,7 @@ impl Accumulation {
             albedo: Some(vec![[0.0; 3]; n]),
             paths: 0,
             seconds: 0.0,
+            device: String::new(),
         }
     }
 
@@ -81,6 +84,7 @@ impl Accumulation {
         self.passes += 1;
         self.paths += r.stats.counters.paths;
         self.seconds += r.stats.wall_seconds;
+        self.device.clone_from(&r.stats.device);
         true
     }
 

@@ -45,6 +45,13 @@ pub fn render_command(input: &Path, o: &Overrides) -> String {
     flag("albedo", o.albedo.map(text));
     flag("g", o.g.map(text));
     flag("exposure", o.exposure.map(text));
+    // The CPU is the default: said only when another device rendered.
+    flag(
+        "device",
+        o.device
+            .filter(|d| *d != cirrus_scene::Device::Cpu)
+            .map(|d| d.name().to_string()),
+    );
     args.push("-o".into());
     args.push(format!("{stem}.render.exr"));
     args.push("--png".into());

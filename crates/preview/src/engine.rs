@@ -58,8 +58,8 @@ struct Engine {
     preview_key: Option<Overrides>,
     /// A key whose render failed: not retried until the view changes.
     failed: Option<Overrides>,
-    /// Measured paths per second, per integrator.
-    rates: HashMap<&'static str, f64>,
+    /// Measured paths per second, per integrator and device.
+    rates: HashMap<(&'static str, &'static str), f64>,
 }
 
 /// Runs until [`Shared::quit`].
@@ -147,7 +147,7 @@ impl Engine {
     fn preview_res(&self, key: &Overrides, (w, h): (u32, u32)) -> Option<(u32, u32)> {
         let rate = self
             .rates
-            .get(integrator(key))
+            .get(&rate_key(key))
             .copied()
             .unwrap_or(GUESS_RATE);
         let target = rate * PREVIEW_SECONDS;
@@ -172,7 +172,7 @@ impl Engine {
             Err(e) => return self.fail(shared, p.key, e.to_string()),
         };
         let rate = r.stats.counters.paths as f64 / seconds.max(1e-9);
-        let old = self.rates.entry(integrator(&p.key)).or_insert(rate);
+        let old = self.rates.entry(rate_key(&p.key)).or_insert(rate);
         *old = 0.5 * (*old + rate);
         let (w, h) = p.overrides.res.unwrap_or((r.image.width, r.image.height));
         if (r.image.width, r.image.height) != (w, h) {
@@ -252,6 +252,11 @@ fn with_samples(key: &Overrides, res: (u32, u32), spp: u32, seed: u64) -> Overri
     }
 }
 
+/// What a pass's speed depends on most: its integrator and its device.
+fn rate_key(key: &Overrides) -> (&'static str, &'static str) {
+    (integrator(key), key.device.unwrap_or_default().name())
+}
+
 fn integrator(key: &Overrides) -> &'static str {
     key.integrator.map_or("path", |i| i.name())
 }
@@ -281,6 +286,8 @@ fn meta(
         "paths_per_second": a.paths_per_second(),
         "seconds": a.seconds,
         "integrator": integrator(&a.key),
+        // Where the last pass ran ("cpu", or "gpu: " and the adapter).
+        "device": a.device,
         "exposure": exposure,
         "denoised": denoised,
     })

@@ -7,7 +7,7 @@
 //!   once; a scene file is re-rendered through the scene library) and
 //!   renders one pass for a set of `cirrus render` overrides.
 //! - [`view`] is what the page controls (camera, sun, sky, medium,
-//!   exposure, integrator) and turns it into those overrides; equal
+//!   exposure, integrator, device) and turns it into those overrides; equal
 //!   overrides key one accumulation.
 //! - `engine` is the render thread: a quick low-resolution pass after each
 //!   change, then full-resolution passes with distinct seeds, averaged by
@@ -44,7 +44,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use cirrus_scene::{Error, Result};
+use cirrus_scene::{Device, Error, Result};
 
 pub use http::MAX_BODY;
 
@@ -68,6 +68,9 @@ pub struct Config {
     /// With no page connected, rendering stops this long after the last
     /// change.
     pub idle: Duration,
+    /// Where passes render; `None` takes the scene's `[render] device`
+    /// (the CPU unless it says otherwise). The page can change it.
+    pub device: Option<Device>,
 }
 
 impl Config {
@@ -79,6 +82,7 @@ impl Config {
             res: None,
             max_spp: 4096,
             idle: Duration::from_secs(10),
+            device: None,
         }
     }
 }
@@ -97,7 +101,7 @@ pub fn start(config: Config) -> Result<Preview> {
     if config.max_spp == 0 {
         return Err(Error::input("max spp must be at least 1"));
     }
-    let source = Source::open(&config.input, config.res)?;
+    let source = Source::open(&config.input, config.res, config.device)?;
     let denoiser =
         frame::denoiser().map(|d| format!("{} {:?}", d.library().display(), d.version()));
     let info = Info {

@@ -4,7 +4,12 @@
 //! through the scene library's one road ([`Scene::render_cached`]) with the
 //! view's overrides, and a [`VolumeCache`] keeps the files and grids read
 //! by the first pass for the next ones. So the preview renders exactly
-//! what `cirrus render` renders for the same flags.
+//! what `cirrus render` renders for the same flags, `--device` included:
+//! a pass goes to the [`RenderTarget`] its device names (opened once,
+//! when first asked for), and a GPU pass is folded into the same
+//! accumulation as a CPU pass would be (the GPU keys its random numbers
+//! by seed, pixel and sample too, so passes with distinct seeds are
+//! independent).
 
 use std::path::Path;
 use std::sync::Arc;
@@ -12,7 +17,7 @@ use std::sync::Arc;
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{RenderControl, Rendered};
 use cirrus_scene::description::SceneDescription;
-use cirrus_scene::{Overrides, Result, Scene, VolumeCache};
+use cirrus_scene::{Device, Overrides, RenderTarget, Result, Scene, VolumeCache};
 use glam::Vec3;
 
 use crate::view::{sun_angles, CameraView, Lighting, Mode, SunView, View};
@@ -35,17 +40,23 @@ pub struct Source {
 
 impl Source {
     /// Opens `path` (its volumes are read here, so errors show before the
-    /// server starts); `res` overrides the scene's resolution.
-    pub fn open(path: &Path, res: Option<(u32, u32)>) -> Result<Source> {
+    /// server starts); `res` overrides the scene's resolution, `device`
+    /// the scene's `[render] device` (whose GPU is opened here too, so a
+    /// missing Vulkan driver is said before the server starts).
+    pub fn open(path: &Path, res: Option<(u32, u32)>, device: Option<Device>) -> Result<Source> {
         let mut scene = Scene::load(path)?;
         scene.apply(&Overrides {
             res,
+            device,
             ..Default::default()
         });
+        let device = scene.settings()?.device;
+        let target = RenderTarget::open(device)?;
         let desc = scene.description().clone();
         let base_res = desc.camera.res();
         let lighting = lighting(&desc);
         let mut view = initial_view(&desc);
+        view.device = device;
         let mut cache = VolumeCache::default();
         {
             // The library's own camera (framed when none is given) and
@@ -77,6 +88,7 @@ impl Source {
                 base: scene,
                 cache,
                 aovs: false,
+                targets: vec![(device, target)],
             },
             view,
             lighting,
@@ -109,6 +121,7 @@ fn initial_view(desc: &SceneDescription) -> View {
         g: None,
         exposure: desc.output.exposure(),
         integrator: Mode::Auto,
+        device: Device::Cpu,
         interactive: false,
         denoise: false,
         viewport: None,
@@ -134,20 +147,39 @@ fn lighting(desc: &SceneDescription) -> Lighting {
 pub struct SceneRenderer {
     pub base: Scene,
     cache: VolumeCache,
-    /// Keep the albedo AOV (it guides the denoiser).
+    /// Keep the albedo AOV (it guides the denoiser) where the CPU renders.
     pub aovs: bool,
+    /// The devices opened so far, each once.
+    targets: Vec<(Device, RenderTarget)>,
+}
+
+impl SceneRenderer {
+    /// Where `device` renders (its index in `targets`), opened the first
+    /// time it is asked for.
+    fn target(&mut self, device: Device) -> Result<usize> {
+        if let Some(i) = self.targets.iter().position(|(d, _)| *d == device) {
+            return Ok(i);
+        }
+        self.targets.push((device, RenderTarget::open(device)?));
+        Ok(self.targets.len() - 1)
+    }
 }
 
 impl Renderer for SceneRenderer {
     fn render(&mut self, o: &Overrides, control: Arc<RenderControl>) -> Result<Rendered> {
         let mut scene = self.base.clone();
         scene.apply(o);
-        if self.aovs {
+        let device = scene.settings()?.device;
+        // The GPU renders no AOVs: its passes are denoised unguided, as a
+        // pass without the albedo is (`Accumulation::add`).
+        let i = self.target(device)?;
+        let target = &self.targets[i].1;
+        if self.aovs && !target.is_gpu() {
             scene.apply(&Overrides {
                 aov: Some(vec![Aov::Albedo]),
                 ..Default::default()
             });
         }
-        scene.render_cached(&mut self.cache, Some(control))
+        target.render_cached(&scene, &mut self.cache, Some(control))
     }
 }

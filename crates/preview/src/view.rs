@@ -1,5 +1,5 @@
 //! What the page controls: the [`View`] (camera, sun, sky, medium,
-//! exposure, integrator), the partial updates the page sends
+//! exposure, integrator, device), the partial updates the page sends
 //! ([`ViewPatch`]), and the [`Overrides`] a view renders with.
 //!
 //! The page never names a file: a patch has numbers, flags and one
@@ -8,7 +8,7 @@
 
 use cirrus_render::IntegratorKind;
 use cirrus_scene::description::Colour;
-use cirrus_scene::Overrides;
+use cirrus_scene::{Device, Overrides};
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -69,6 +69,8 @@ pub struct View {
     /// Stops, applied when frames are tone-mapped (no re-render).
     pub exposure: f32,
     pub integrator: Mode,
+    /// Where passes render (`cirrus render --device`).
+    pub device: Device,
     /// The user is dragging (a slider or the camera).
     pub interactive: bool,
     /// Denoise displayed frames (when the library loads).
@@ -89,6 +91,7 @@ pub struct ViewPatch {
     pub g: Option<f32>,
     pub exposure: Option<f32>,
     pub integrator: Option<Mode>,
+    pub device: Option<Device>,
     pub interactive: Option<bool>,
     pub denoise: Option<bool>,
     pub viewport: Option<[u32; 2]>,
@@ -162,6 +165,9 @@ impl View {
         if let Some(m) = patch.integrator {
             v.integrator = m;
         }
+        if let Some(d) = patch.device {
+            v.device = d;
+        }
         if let Some(i) = patch.interactive {
             v.interactive = i;
         }
@@ -178,10 +184,14 @@ impl View {
     }
 
     /// The integrator that renders now, and its ray-march step if it is
-    /// not the scene's.
+    /// not the scene's. Drags march only on the CPU: the GPU has no ray
+    /// marcher, and path-traces the quick low-resolution passes instead
+    /// (under `auto` too, which may land on a GPU).
     pub fn integrator_now(&self) -> (IntegratorKind, Option<f32>) {
         match self.integrator {
-            Mode::Auto if self.interactive => (IntegratorKind::RayMarch, Some(DRAG_STEP)),
+            Mode::Auto if self.interactive && self.device == Device::Cpu => {
+                (IntegratorKind::RayMarch, Some(DRAG_STEP))
+            }
             Mode::Auto | Mode::Path => (IntegratorKind::Path, None),
             Mode::Raymarch => (IntegratorKind::RayMarch, None),
             Mode::Raymarch2pass => (IntegratorKind::RayMarch2Pass, None),
@@ -220,6 +230,7 @@ impl View {
             g: self.g,
             integrator: Some(integrator),
             step,
+            device: Some(self.device),
             // Frames are denoised after accumulation, never per pass.
             denoise: Some(false),
             ..Default::default()
@@ -295,6 +306,7 @@ mod tests {
             g: Some(0.5),
             exposure: 0.0,
             integrator: Mode::Auto,
+            device: Device::Cpu,
             interactive: false,
             denoise: false,
             viewport: None,
@@ -323,6 +335,8 @@ mod tests {
         }
         assert!(serde_json::from_str::<ViewPatch>(r#"{"file": "/etc/passwd"}"#).is_err());
         assert!(serde_json::from_str::<ViewPatch>(r#"{"albedo": NaN}"#).is_err());
+        assert!(serde_json::from_str::<ViewPatch>(r#"{"device": "tpu"}"#).is_err());
+        assert!(serde_json::from_str::<ViewPatch>(r#"{"device": "GPU"}"#).is_err());
     }
 
     #[test]
@@ -343,6 +357,14 @@ mod tests {
         let drag = v.patched(&p).unwrap().render_overrides(&lighting, (64, 64));
         assert_eq!(drag.integrator, Some(IntegratorKind::RayMarch));
         assert_eq!(key.integrator, Some(IntegratorKind::Path));
+        // The GPU has no marcher: its drags path-trace, and the device
+        // keys the accumulation (its estimators differ from the CPU's).
+        let p: ViewPatch =
+            serde_json::from_str(r#"{"device": "gpu", "interactive": true}"#).unwrap();
+        let gpu = v.patched(&p).unwrap().render_overrides(&lighting, (64, 64));
+        assert_eq!(gpu.integrator, Some(IntegratorKind::Path));
+        assert_eq!(gpu.device, Some(Device::Gpu));
+        assert_ne!(gpu, key);
     }
 
     #[test]

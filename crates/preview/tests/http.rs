@@ -197,6 +197,8 @@ fn malformed_and_oversized_requests_get_4xx_and_change_nothing() {
         r#"{"camera": {"from": [1, 2], "to": [0, 0, 0], "up": [0, 1, 0], "fov": 40}}"#,
         r#"{"viewport": [0, 0]}"#,
         r#"{"integrator": "magic"}"#,
+        r#"{"device": "tpu"}"#,
+        r#"{"device": 1}"#,
         r#"{"sun": {"elevation": 1000}}"#,
         "\u{0}\u{1}binary",
     ] {
@@ -399,6 +401,127 @@ fn rendering_stops_when_idle_without_a_page_and_resumes_with_one() {
     assert_eq!(spp(addr), stopped, "still rendering with nobody watching");
     let mut ws = connect(addr);
     frame_until(&mut ws, |m| m["spp"].as_u64() > Some(stopped));
+    p.shutdown();
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The mean of every pixel's RGB in the accumulation `/save` wrote.
+fn saved_mean(dir: &Path, w: usize, h: usize) -> f64 {
+    let exr = exr::prelude::read_first_rgba_layer_from_file(
+        dir.join("cloud.preview.exr"),
+        |res, _| vec![[0f32; 4]; res.width() * res.height()],
+        move |px, pos, (r, g, b, a): (f32, f32, f32, f32)| px[pos.y() * w + pos.x()] = [r, g, b, a],
+    )
+    .unwrap();
+    let px = &exr.layer_data.channel_data.pixels;
+    assert_eq!(px.len(), w * h);
+    assert!(px.iter().flatten().all(|v| v.is_finite()));
+    px.iter()
+        .map(|p| f64::from(p[0] + p[1] + p[2]) / 3.0)
+        .sum::<f64>()
+        / (w * h) as f64
+}
+
+/// Whether `message` says there is no Vulkan adapter; then CI (which
+/// installs lavapipe) fails, and elsewhere the install hint must be named.
+fn no_adapter(message: &str) -> bool {
+    let none = message.contains("no Vulkan adapter");
+    if none {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI has no Vulkan adapter: {message}"
+        );
+        assert!(message.contains("mesa-vulkan-drivers"), "{message}");
+        eprintln!("SKIPPED: {message}");
+    }
+    none
+}
+
+/// Reads messages until an error frame; returns its message.
+fn error_frame(ws: &mut Socket) -> String {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while Instant::now() < deadline {
+        if let tungstenite::Message::Text(t) = ws.read().unwrap() {
+            let meta: Value = serde_json::from_str(t.as_str()).unwrap();
+            if meta["type"] == "error" {
+                return meta["message"].as_str().unwrap().to_string();
+            }
+        }
+    }
+    panic!("no error frame in time");
+}
+
+/// The page switches a CPU preview to the GPU (opened then, once): its
+/// passes accumulate as the CPU's do, to the same image within the noise;
+/// the command line says the device; what the GPU does not render is an
+/// error frame naming it, and a CPU view renders again after it.
+#[test]
+fn the_page_moves_passes_to_the_gpu_and_they_accumulate() {
+    let dir = workdir("gpu");
+    let mut c = Config::new(dir.join("cloud.vdb"));
+    c.port = 0;
+    c.res = Some((32, 24));
+    c.max_spp = 16;
+    let p = start(c).unwrap();
+    let addr = p.addr();
+    assert_eq!(get(addr, "/state").json()["view"]["device"], "cpu");
+    let mut ws = connect(addr);
+    let (m, _) = frame_until(&mut ws, |m| m["spp"] == 16);
+    assert_eq!(m["device"], "cpu", "{m}");
+    assert_eq!(post(addr, "/save", "{}").status, 200);
+    let cpu = saved_mean(&dir, 32, 24);
+
+    let r = post(addr, "/view", r#"{"device": "gpu"}"#);
+    assert_eq!(r.status, 200, "{}", r.body);
+    assert_eq!(r.json()["view"]["device"], "gpu");
+    let version = r.json()["version"].as_u64().unwrap();
+    // Frames of the CPU view may still arrive first; the GPU's follow.
+    let m = loop {
+        let tungstenite::Message::Text(t) = ws.read().unwrap() else {
+            continue;
+        };
+        let meta: Value = serde_json::from_str(t.as_str()).unwrap();
+        if meta["type"] == "error" {
+            let message = meta["message"].as_str().unwrap();
+            assert!(no_adapter(message), "{message}");
+            p.shutdown();
+            return;
+        }
+        if meta["version"].as_u64() >= Some(version) && meta["spp"] == 16 {
+            break meta;
+        }
+    };
+    let device = m["device"].as_str().unwrap();
+    assert!(device.starts_with("gpu: "), "{m}");
+    assert!(
+        m["passes"].as_u64() > Some(1),
+        "one pass is no accumulation: {m}"
+    );
+    assert_eq!(post(addr, "/save", "{}").status, 200);
+    let gpu = saved_mean(&dir, 32, 24);
+    eprintln!("image mean: cpu {cpu}, gpu {gpu}");
+    // 32x24 pixels at 16 spp: the image means of the two devices'
+    // estimators (same expectation) lie well within 5% of each other.
+    assert!(cpu > 0.01, "the cloud is lit: {cpu}");
+    assert!(
+        (gpu - cpu).abs() < 0.05 * cpu,
+        "gpu {gpu} against cpu {cpu}"
+    );
+    let c = get(addr, "/command").json();
+    assert!(
+        c["command"].as_str().unwrap().contains("--device gpu"),
+        "{c}"
+    );
+
+    // The GPU has no ray marcher: refused by name, on the page.
+    let r = post(addr, "/view", r#"{"integrator": "raymarch"}"#);
+    assert_eq!(r.status, 200, "{}", r.body);
+    let message = error_frame(&mut ws);
+    assert!(message.contains("the raymarch integrator"), "{message}");
+    assert_eq!(post(addr, "/view", r#"{"device": "cpu"}"#).status, 200);
+    frame_until(&mut ws, |m| {
+        m["device"] == "cpu" && m["integrator"] == "raymarch"
+    });
     p.shutdown();
     let _ = std::fs::remove_dir_all(dir);
 }

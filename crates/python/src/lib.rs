@@ -19,7 +19,9 @@ use std::time::Duration;
 
 use cirrus_render::exr_layers::Aov;
 use cirrus_render::{RenderControl, Rendered};
-use cirrus_scene::{Device, Error, ErrorKind, Overrides, RenderTarget, Scene, SceneDescription};
+use cirrus_scene::{
+    Device, Error, ErrorKind, Overrides, RenderTarget, Scene, SceneDescription, VolumeCache,
+};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -201,11 +203,14 @@ fn render_watched(
     let worker_control = control.clone();
     let worker = std::thread::spawn(move || {
         // `device = "gpu"|"auto"` (the scene's, or the keyword's) renders
-        // where `cirrus render --device` would; the CPU is watched.
+        // where `cirrus render --device` would; the CPU is watched (`auto`'s
+        // fall-back to it too), a GPU render runs to its end.
         let device = scene.settings().map(|s| s.device).unwrap_or_default();
         let run = || match device {
             Device::Cpu => scene.render_with(Some(worker_control)),
-            _ => RenderTarget::open(device).and_then(|t| t.render(&scene)),
+            _ => RenderTarget::open(device).and_then(|t| {
+                t.render_cached(&scene, &mut VolumeCache::default(), Some(worker_control))
+            }),
         };
         let result = match threads {
             None => run(),

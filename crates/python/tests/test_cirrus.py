@@ -327,9 +327,11 @@ def test_device_chooses_where_a_render_runs(tmp_path):
         assert "CI" not in os.environ, r.stderr
         pytest.skip(r.stderr)
     assert r.returncode == 0, r.stderr
-    image, _ = cirrus.render(CLOUD, device="gpu", res="16x12", spp=2, seed=5)
+    image, stats = cirrus.render(CLOUD, device="gpu", res="16x12", spp=2, seed=5)
     np.testing.assert_array_equal(image, exr_rgba(exr))
-    cpu, _ = cirrus.render(CLOUD, device="cpu", res="16x12", spp=2, seed=5)
+    assert stats["device"].startswith("gpu: "), stats["device"]
+    cpu, stats = cirrus.render(CLOUD, device="cpu", res="16x12", spp=2, seed=5)
     assert not np.array_equal(cpu, image)
+    assert stats["device"] == "cpu"
     with pytest.raises(ValueError, match="the raymarch integrator"):
         cirrus.render(CLOUD, device="gpu", res="8x8", spp=1, integrator="raymarch")

@@ -138,6 +138,7 @@ fn render_with<M: Media>(
     let wall_seconds = start.elapsed().as_secs_f64();
     let samples = &out.image.samples;
     let stats = RenderStats {
+        device: "cpu".into(),
         integrator: settings.integrator.name().into(),
         transmittance: settings.transmittance.name().into(),
         majorant: settings.majorant.name().into(),

@@ -8,6 +8,8 @@ use cirrus_kernel::Counters;
 /// The statistics of a render, serialisable to JSON for benchmarks.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct RenderStats {
+    /// Where the render ran: "cpu", or "gpu: " and the adapter.
+    pub device: String,
     pub integrator: String,
     pub transmittance: String,
     /// The majorant structure walked; with `auto`, the one chosen

@@ -5,7 +5,9 @@
 //! render).
 
 use cirrus_gpu::{Gpu, GpuError};
-use cirrus_render::Rendered;
+use std::sync::Arc;
+
+use cirrus_render::{RenderControl, Rendered};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
@@ -72,15 +74,32 @@ impl RenderTarget {
         }
     }
 
+    /// Whether renders go to a GPU (under `auto`, one in hardware).
+    pub fn is_gpu(&self) -> bool {
+        matches!(self, RenderTarget::Gpu(..))
+    }
+
     /// Renders `scene` here. Under `auto`, a scene the GPU does not render
     /// goes to the CPU, saying why; under `gpu` it is an error naming what.
     pub fn render(&self, scene: &Scene) -> Result<Rendered> {
+        self.render_cached(scene, &mut VolumeCache::default(), None)
+    }
+
+    /// [`RenderTarget::render`] with the volumes read through `cache` (kept
+    /// for the next render, as [`Scene::render_cached`] does). `control`
+    /// watches and stops a CPU render; a GPU render is not stopped midway
+    /// (a cancelled one is reported as such once it returns).
+    pub fn render_cached(
+        &self,
+        scene: &Scene,
+        cache: &mut VolumeCache,
+        control: Option<Arc<RenderControl>>,
+    ) -> Result<Rendered> {
         let (gpu, device) = match self {
-            RenderTarget::Cpu => return scene.render(),
+            RenderTarget::Cpu => return scene.render_cached(cache, control),
             RenderTarget::Gpu(gpu, device) => (gpu, *device),
         };
-        let mut cache = VolumeCache::default();
-        let prepared = scene.prepare(&mut cache, None)?;
+        let prepared = scene.prepare(cache, control.clone())?;
         if scene.warn_on_stderr {
             for w in &prepared.warnings {
                 eprintln!("cirrus: warning: {w}");
@@ -89,23 +108,36 @@ impl RenderTarget {
         match cirrus_gpu::render(gpu, &prepared.scene, &prepared.settings) {
             Ok(mut rendered) => {
                 if let Some(means) = cirrus_gpu::substitutions(&prepared.settings) {
-                    eprintln!("cirrus: the GPU estimates the same image with {means}");
+                    if scene.warn_on_stderr {
+                        eprintln!("cirrus: the GPU estimates the same image with {means}");
+                    }
                 }
                 let s = &mut rendered.stats;
+                s.device = format!("gpu: {}", gpu.describe());
                 s.bytes_read = prepared.bytes_read;
                 s.grids_loaded = prepared.grids_loaded;
                 s.volumes_culled = prepared.culled;
                 s.load_seconds = prepared.load_seconds;
+                if control.as_ref().is_some_and(|c| c.is_cancelled()) {
+                    return Err(Error::cancelled());
+                }
                 Scene::refuse_all_dropped(&rendered)?;
                 Ok(rendered)
             }
             Err(GpuError::Unsupported(what)) if device == Device::Auto => {
-                eprintln!(
-                    "cirrus: the GPU does not render {} yet: rendering on the CPU",
+                // Said where it is seen: on stderr for the command line,
+                // with the render's warnings for Python, Blender and farms.
+                let why = format!(
+                    "the GPU does not render {} yet: rendered on the CPU",
                     what.join(", ")
                 );
+                if scene.warn_on_stderr {
+                    eprintln!("cirrus: {why}");
+                }
                 drop(prepared);
-                scene.render()
+                let mut rendered = scene.render_cached(cache, control)?;
+                rendered.stats.warnings.push(why);
+                Ok(rendered)
             }
             Err(e) => Err(Error::input(e.to_string())),
         }

@@ -508,3 +508,72 @@ def fcurves(action):
         return [fc for layer in action.layers for strip in layer.strips
                 for bag in strip.channelbags for fc in bag.fcurves]
     return list(action.fcurves)
+
+
+def reports(addon, level: str) -> list[str]:
+    return [m for lv, m in addon.engine.REPORTS if lv == level]
+
+
+def no_adapter(messages: list[str]) -> bool:
+    """Whether cirrus said there is no Vulkan adapter; then CI (which
+    installs lavapipe) fails, and elsewhere the install hint is named."""
+    none = any("no Vulkan adapter" in m for m in messages)
+    if none:
+        assert "CI" not in os.environ, messages
+        assert any("mesa-vulkan-drivers" in m for m in messages), messages
+    return none
+
+
+def failed_render(scene) -> None:
+    """A render whose engine reported an error: Blender's operator says so
+    (in the interface, a message in the status bar), and writes nothing."""
+    scene.render.filepath = ""
+    with pytest.raises(RuntimeError, match="Error: "):
+        bpy.ops.render.render(write_still=False)
+
+
+def test_the_device_setting_chooses_where_cirrus_renders(addon, tmp_path):
+    """Auto by default; GPU Compute renders the image `cirrus.render(...,
+    device="gpu")` renders, bit for bit; what the GPU does not render (a
+    pass, a point lamp) is an error report naming it, and no image; a pass
+    sends Auto to the CPU, which says so."""
+    import cirrus
+
+    scene, _ = build_scene()
+    scene.render.engine = "CIRRUS"
+    scene.render.resolution_x = scene.render.resolution_y = 12
+    assert scene.cirrus.device == "AUTO"
+    scene.cirrus.spp, scene.cirrus.seed = 2, 3
+    scene.cirrus.device = "GPU"
+    try:
+        image = render_to_array(scene, tmp_path / "gpu.exr")
+    except RuntimeError:
+        if no_adapter(reports(addon, "ERROR")):
+            pytest.skip(str(reports(addon, "ERROR")))
+        raise
+    assert any(m.startswith("cirrus rendered on the GPU: ") for m in reports(addon, "INFO"))
+    desc, _ = addon.export.scene_description(bpy.context.evaluated_depsgraph_get(), (12, 12))
+    expected, stats = cirrus.render(desc, device="gpu", spp=2, seed=3)
+    assert stats["device"].startswith("gpu: ")
+    np.testing.assert_array_equal(image.astype(np.float32), expected)
+    assert expected[..., 3].max() > 0.0, "the cloud is in view"
+
+    # A pass the GPU does not render: refused by name, in Blender's words.
+    scene.view_layers[0].cirrus.use_pass_albedo = True
+    failed_render(scene)
+    [error] = reports(addon, "ERROR")
+    assert "Device GPU Compute does not render passes other than Combined" in error, error
+    assert "set Device to CPU" in error, error
+    # Auto takes the CPU for it (a hardware GPU would say why).
+    scene.cirrus.device = "AUTO"
+    render_to_array(scene, tmp_path / "auto.exr")
+    assert reports(addon, "ERROR") == []
+    assert "cirrus rendered on the CPU" in reports(addon, "INFO")
+    scene.view_layers[0].cirrus.use_pass_albedo = False
+
+    # A lamp the GPU does not render.
+    add_lamps(scene)
+    scene.cirrus.device = "GPU"
+    failed_render(scene)
+    [error] = reports(addon, "ERROR")
+    assert "sphere, point and spot lights" in error, error

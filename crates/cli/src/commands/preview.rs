@@ -1,4 +1,4 @@
-//! `cirrus preview FILE|SCENE.toml|STAGE.usd [--port P] [--bind ADDR]`: serves a
+//! `cirrus preview FILE|SCENE.toml|STAGE.usd [--port P] [--bind ADDR] [--device D]`: serves a
 //! live progressive render to the browser (`cirrus-preview`) and prints
 //! its URL.
 
@@ -25,6 +25,12 @@ pub struct PreviewArgs {
     /// Stop accumulating at this many samples per pixel.
     #[arg(long, default_value_t = 4096)]
     pub max_spp: u32,
+    /// Where passes render, as `cirrus render --device` (default: the
+    /// scene file's `[render] device`, else cpu); the page can change it.
+    /// The GPU path-traces the quick passes while you drag (it has no ray
+    /// marcher).
+    #[arg(long, value_enum)]
+    pub device: Option<cirrus_scene::Device>,
 }
 
 pub fn run(args: &PreviewArgs) -> CliResult {
@@ -33,6 +39,7 @@ pub fn run(args: &PreviewArgs) -> CliResult {
     config.bind = args.bind;
     config.res = args.res;
     config.max_spp = args.max_spp;
+    config.device = args.device;
     if !args.bind.is_loopback() {
         eprintln!(
             "cirrus preview: listening on {}: anyone who can reach it can steer the render",

@@ -15,7 +15,7 @@ import distributed
 
 from .frames import FrameSpecError, parse_frame_range
 from .job import TaskReport, render_job
-from .plan import PlanError, plan_job
+from .plan import PlanError, check_device, plan_job
 from .tiles import TileSpecError, parse_size
 
 USAGE_EXAMPLE = (
@@ -62,6 +62,11 @@ def _parser() -> argparse.ArgumentParser:
     render.add_argument("--retries", type=int, default=3, metavar="N",
                         help="times a task that raised (its cirrus killed by a signal) is run "
                              "again (default 3); tasks of a dead worker are rerun by the scheduler")
+    render.add_argument("--device", choices=("cpu", "auto", "gpu"),
+                        help="where every render runs, as 'cirrus render --device': cpu, auto "
+                             "(a hardware GPU where a worker has one, else its CPU) or gpu "
+                             "(default: each worker's $CIRRUS_DEVICE, else the scene's "
+                             "[render] device, else cpu)")
     render.add_argument("--threads-per-task", type=int, metavar="N",
                         help="cirrus threads per task (default: cores / N with --local, "
                              "all cores with --scheduler)")
@@ -109,12 +114,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     job = dict(
         tiles=tiles, render_flags=render_flags, cirrus=args.cirrus,
         local_workers=args.local, overwrite=args.overwrite, retries=args.retries,
-        threads_per_task=args.threads_per_task, on_task_done=_print_progress,
+        threads_per_task=args.threads_per_task, device=args.device,
+        on_task_done=_print_progress,
     )
     try:
         if args.scheduler:
             # Checked before connecting, so a typo does not wait on the network.
             plan_job(args.input, args.output, frames, tiles, render_flags)
+            check_device(args.device, render_flags)
             try:
                 client = distributed.Client(args.scheduler)
             except OSError as e:  # unreachable: distributed raises OSError or TimeoutError

@@ -22,7 +22,7 @@ import distributed
 from . import worker_tasks
 from .cluster import local_client
 from .frames import FrameSpecError, parse_frame_range
-from .plan import FramePlan, PlanError, plan_job, without_flag
+from .plan import FramePlan, PlanError, check_device, plan_job, without_flag
 from .shipping import ShippedByValue
 
 RENDER_TILE = ShippedByValue(worker_tasks.render_tile, worker_tasks)
@@ -112,6 +112,7 @@ def render_job(
     overwrite: bool = False,
     retries: int = 3,
     threads_per_task: int | None = None,
+    device: str | None = None,
     on_task_done: Callable[[TaskReport], None] | None = None,
 ) -> JobResult:
     """Renders `frames` of `input_pattern` into `output_pattern` on `client`.
@@ -124,6 +125,11 @@ def render_job(
     per core) runs the job, started only if some frame needs rendering.
     `threads_per_task` caps each cirrus run's threads (default: all cores
     of its machine, or an equal share of them on a local cluster).
+    `device` ("cpu", "auto" or "gpu", as `cirrus render --device`) is
+    where every frame's and tile's render runs; without it, each worker's
+    $CIRRUS_DEVICE, else the scene's `[render] device` (the CPU unless it
+    says otherwise). "auto" suits a mixed cluster: a hardware GPU where a
+    worker has one, else its CPU.
 
     Plan errors (bad patterns, tiles, flags) raise `PlanError` before
     anything runs; a frame that fails does not stop the others and shows
@@ -134,6 +140,7 @@ def render_job(
     except FrameSpecError as e:
         raise PlanError(str(e)) from None
     plans = plan_job(input_pattern, output_pattern, frame_list, tiles, render_flags)
+    check_device(device, render_flags)
     cirrus = _binary_path(cirrus or os.environ.get("CIRRUS_BIN") or "cirrus")
     results = {p.frame: FrameResult(p.frame, p.input, p.output, "pending") for p in plans}
     todo = []
@@ -148,7 +155,7 @@ def render_job(
             threads_per_task = max(1, (os.cpu_count() or 1) // (local_workers or os.cpu_count() or 1))
         with _client_or_local(client, local_workers) as running:
             submitted = _submit(running, todo, cirrus, render_flags, overwrite,
-                                retries, threads_per_task)
+                                retries, threads_per_task, device)
             _collect(submitted, results, on_task_done)
     return JobResult([results[f] for f in sorted(results)])
 
@@ -178,6 +185,7 @@ def _submit(
     overwrite: bool,
     retries: int,
     threads: int | None,
+    device: str | None,
 ) -> dict[distributed.Future, _Submitted]:
     """Submits every frame's tasks; earlier frames get higher priority so
     finished frames (and their merges) appear in order, not all at the end."""
@@ -196,7 +204,7 @@ def _submit(
         if plan.renders_straight_to_output:
             future = client.submit(
                 RENDER_TILE, cirrus, plan.input, plan.output, task_flags(plan.deep),
-                None, False, threads, cwd,
+                None, False, threads, cwd, device,
                 key=f"{frame_key}-render", retries=retries, priority=priority,
             )
             submitted[future] = _Submitted(plan, "frame", None)
@@ -207,7 +215,7 @@ def _submit(
             assert tile is not None
             future = client.submit(
                 RENDER_TILE, cirrus, plan.input, task.path, task_flags(task.deep),
-                tile.crop_flag, not overwrite, threads, cwd,
+                tile.crop_flag, not overwrite, threads, cwd, device,
                 key=f"{frame_key}-tile-{tile.column}-{tile.row}",
                 retries=retries, priority=priority,
             )

@@ -29,8 +29,24 @@ _FLAGS_THE_FARM_OWNS = {
 }
 
 
+# Where a render runs (`cirrus render --device`).
+DEVICES = ("cpu", "auto", "gpu")
+
+
 class PlanError(ValueError):
     """A job that cannot be planned; the message says what to change."""
+
+
+def check_device(device: str | None, flags: Sequence[str]) -> None:
+    """Rejects a device cirrus does not know, and a device given twice
+    (the job's and `--device` among the pass-through flags)."""
+    if device is None:
+        return
+    if device not in DEVICES:
+        raise PlanError(f"device {device!r}: use one of {', '.join(DEVICES)}")
+    if flag_value(flags, "--device") is not None:
+        raise PlanError("the device is given twice: as the job's device and as --device "
+                        "after '--'; keep one")
 
 
 @dataclass(frozen=True)

@@ -81,8 +81,13 @@ def render_tile(
     reuse_existing: bool,
     threads: int | None = None,
     cwd: str | None = None,
+    device: str | None = None,
 ) -> dict:
     """Renders one tile (or a whole frame if `crop` is None) to `output_path`.
+
+    `device` is the job's (`cirrus render --device`); without one, and
+    without `--device` among the flags, this worker's $CIRRUS_DEVICE (a
+    GPU node's workers may set it to "gpu" or "auto").
 
     cirrus writes its output to a temporary name and renames it, so an
     existing file is a finished one: with `reuse_existing` it is kept and
@@ -92,6 +97,10 @@ def render_tile(
     if reuse_existing and os.path.exists(output_path):
         return {"status": "reused", "seconds": 0.0, "host": host}
     args = [cirrus, "render", input_path, "-o", output_path, *render_flags]
+    given = any(f == "--device" or f.startswith("--device=") for f in render_flags)
+    device = device or (None if given else os.environ.get("CIRRUS_DEVICE") or None)
+    if device is not None:
+        args += ["--device", device]
     if crop is not None:
         args += ["--crop", crop]
     outcome = _run_cirrus(args, threads, cwd)
