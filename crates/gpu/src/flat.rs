@@ -66,13 +66,18 @@ pub struct Params {
     /// the volume's largest density (y).
     pub walk: [f32; 4],
     /// Majorants (x: [`WALK_HIERARCHY`] or [`WALK_GLOBAL`]), shadow rays'
-    /// estimator (y: `TRANSMITTANCE_*`).
+    /// estimator (y: `TRANSMITTANCE_*`), [`VOXEL_CELL_CORNERS`] (z).
     pub walk_mode: [u32; 4],
     /// Level-1 cells of the partition per axis.
     pub part_dims: [u32; 4],
     /// Per pyramid level: cells per axis, its first float in `pyramid`.
     pub levels: [[u32; 4]; MAX_LEVELS],
 }
+
+/// The corners of a voxel cell, a parameter rather than a constant in the
+/// kernel so that its loops over them stay rolled (`corners` in
+/// `shaders/common.wgsl` says why).
+pub const VOXEL_CELL_CORNERS: u32 = 8;
 
 /// Majorant modes (`shaders/walk.wgsl`).
 pub const WALK_HIERARCHY: u32 = 0;
@@ -179,7 +184,7 @@ impl FlatScene {
             walk_mode: [
                 walk_mode(walk.majorant),
                 estimator(walk.transmittance),
-                0,
+                VOXEL_CELL_CORNERS,
                 0,
             ],
             part_dims: [pd[0], pd[1], pd[2], 0],

@@ -29,7 +29,8 @@ struct Params {
     // voxel by voxel (x), the volume's largest density (y).
     walk: vec4<f32>,
     // Majorants (x: 0 the hierarchy, 1 one global bound), shadow rays'
-    // estimator (y: ratio.wgsl's TRANSMITTANCE_*).
+    // estimator (y: ratio.wgsl's TRANSMITTANCE_*), the corners of a
+    // voxel cell (z: 8, see `corners`).
     walk_mode: vec4<u32>,
     // Level-1 cells of the partition per axis (xyz).
     part_dims: vec4<u32>,
@@ -115,6 +116,18 @@ const ITERATION_BUDGET: u32 = 32768u;
 var<private> real_collisions: u32;
 var<private> null_collisions: u32;
 var<private> shadow_collisions: u32;
+
+// The corners of a voxel cell, 8, read from the parameters so that no
+// compiler unrolls a loop over them. Lavapipe (llvmpipe) runs a branch
+// that any invocation of a SIMD batch takes with all of them masked, so
+// every voxel lookup written out in a loop's body costs each turn of that
+// loop whether taken or not; a loop whose trip count it cannot see stays
+// one lookup long (and is skipped where no invocation enters it). Eight
+// lookups unrolled into the walk's thick-cell branch and the trilinear
+// filter made the kernel 2-3 times slower there.
+fn corners() -> i32 {
+    return i32(params.walk_mode.z);
+}
 
 const PI: f32 = 3.14159265358979;
 const FAR: f32 = 3.0e38;
