@@ -48,7 +48,7 @@ use cirrus_render::{
 
 pub use device::{open, Gpu, GpuError, INSTALL_HINT};
 pub use flat::{FlatScene, LightRecord, Params, WalkChoice};
-pub use kernel::{source, PixelSlot, STAGES};
+pub use kernel::{source, window_bands, PixelSlot, STAGES};
 pub use support::{substitutions, unsupported, PreparedScene};
 
 /// Renders `scene` with `settings` on `gpu`, or says why not: what the
@@ -138,16 +138,22 @@ const EVENTS_PER_DISPATCH: u32 = 4096;
 /// Dispatches queued between checks of whether every pixel is done.
 const DISPATCHES_PER_CHECK: u32 = 8;
 
-/// Dispatches until every pixel has `target` samples.
+/// Dispatches until every pixel has `target` samples, band after band
+/// of the window where its paths exceed a binding.
 fn run_to(kernel: &mut kernel::Kernel, target: u32) -> Result<(), GpuError> {
-    loop {
-        for _ in 0..DISPATCHES_PER_CHECK {
-            kernel.dispatch(target, EVENTS_PER_DISPATCH);
+    for band in 0..kernel.bands() {
+        kernel.enter_band(band)?;
+        loop {
+            for _ in 0..DISPATCHES_PER_CHECK {
+                kernel.dispatch(target, EVENTS_PER_DISPATCH);
+            }
+            if kernel.pending()? == 0 {
+                break;
+            }
         }
-        if kernel.pending()? == 0 {
-            return Ok(());
-        }
+        kernel.leave_band()?;
     }
+    Ok(())
 }
 
 /// The flat form of `scene` for `film`'s window and `settings`' seed and

@@ -417,6 +417,56 @@ fn a_split_atlas_renders_the_same_bytes() {
     assert_eq!(bits(&whole), bits(&split));
 }
 
+/// A window whose paths exceed a binding is rendered band by band of
+/// rows: forced here with the split-atlas test's binding limit and a
+/// window three bands tall (the last one short), the image is the
+/// unsplit one's, bit for bit, samples and variance.
+#[test]
+fn a_window_in_bands_renders_the_same_bytes() {
+    let Some(gpu) = gpu() else { return };
+    let text = |res: &str| {
+        format!(
+            r#"
+            [render]
+            spp = 1
+            seed = 6
+            [camera]
+            res = "{res}"
+            [[volume]]
+            file = "cloud.vdb"
+            "#
+        )
+    };
+    let mut cache = cirrus_scene::VolumeCache::default();
+    let s = scene(&text("8x8"));
+    let prepared = s.prepare(&mut cache, None).expect("scene prepares");
+    let volume = prepared.scene.media.instances()[0]
+        .field
+        .still_field()
+        .volume();
+    let limit = volume.atlas().bytes() as u64 / 3 + 1;
+    drop(prepared);
+    // 80 bytes of path a pixel (kernel.rs, PATH_STATE_BYTES).
+    let width = 160;
+    let rows = (limit / (80 * u64::from(width))) as u32;
+    let height = 2 * rows + rows / 2;
+    let s = scene(&text(&format!("{width}x{height}")));
+    assert_eq!(cirrus_gpu::window_bands(&gpu, width, height).unwrap(), 1);
+    let whole = render_gpu(&gpu, &s).expect("GPU render").image;
+    let small = gpu.with_binding_limit(limit);
+    assert_eq!(cirrus_gpu::window_bands(&small, width, height).unwrap(), 3);
+    let banded = render_gpu(&small, &s).expect("GPU render, banded").image;
+    let bits = |i: &cirrus_render::Image| -> Vec<u32> {
+        i.rgba
+            .iter()
+            .chain(&i.variance)
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect()
+    };
+    assert_eq!(bits(&whole), bits(&banded));
+}
+
 /// A scene whose buffers exceed the device's memory is refused before
 /// anything is uploaded, with the size it needs (forced with a 1 MiB
 /// device).

@@ -160,10 +160,15 @@ fn render_pass(@builtin(global_invocation_id) id: vec3<u32>) {
     let slot = id.y * size.x + id.x;
     let target_samples = params.window.z;
     var st = paths[slot];
+    var acc = film[slot];
+    // Between paths, the next sample is the count taken: the host may
+    // have cleared the paths (a window rendered band by band, kernel.rs).
+    if st.under_way == 0u {
+        st.sample = acc.n;
+    }
     if st.sample >= target_samples {
         return;
     }
-    var acc = film[slot];
     if st.under_way == 0u {
         st = start_path(x, y, pixel, st.sample);
     }
