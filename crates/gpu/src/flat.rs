@@ -72,6 +72,10 @@ pub struct Params {
     pub part_dims: [u32; 4],
     /// Per pyramid level: cells per axis, its first float in `pyramid`.
     pub levels: [[u32; 4]; MAX_LEVELS],
+    /// Each channel's share of the extinction (xyz, the medium's
+    /// `extinction_tint`), and (w) 1 where it is chromatic (tracked per
+    /// channel, `shaders/spectral.wgsl`), 0 where grey.
+    pub tint: [f32; 4],
 }
 
 /// The corners of a voxel cell, a parameter rather than a constant in the
@@ -189,6 +193,16 @@ impl FlatScene {
             ],
             part_dims: [pd[0], pd[1], pd[2], 0],
             levels,
+            tint: [
+                medium.extinction_tint.x,
+                medium.extinction_tint.y,
+                medium.extinction_tint.z,
+                if medium.extinction_tint == Vec3::ONE {
+                    0.0
+                } else {
+                    1.0
+                },
+            ],
             ..camera_params(camera)
         };
         Self {

@@ -12,10 +12,11 @@ use crate::flat::{FlatScene, Params};
 
 /// The kernel's stages, in the order they are joined (WGSL declarations
 /// may come in any order; this is the order to read them in).
-pub const STAGES: [(&str, &str); 8] = [
+pub const STAGES: [(&str, &str); 9] = [
     ("common.wgsl", include_str!("shaders/common.wgsl")),
     ("lookup.wgsl", include_str!("shaders/lookup.wgsl")),
     ("walk.wgsl", include_str!("shaders/walk.wgsl")),
+    ("spectral.wgsl", include_str!("shaders/spectral.wgsl")),
     ("delta.wgsl", include_str!("shaders/delta.wgsl")),
     ("ratio.wgsl", include_str!("shaders/ratio.wgsl")),
     ("phase.wgsl", include_str!("shaders/phase.wgsl")),

@@ -70,9 +70,6 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
         if m.field.moves() || m.field.still_field().moves() {
             no("volume motion blur");
         }
-        if m.extinction_tint != glam::Vec3::ONE {
-            no("chromatic media (a density scale per channel)");
-        }
         if m.emission.is_some() {
             no("emission");
         }

@@ -37,6 +37,9 @@ struct Params {
     // Per pyramid level: cells per axis (xyz), its first float in
     // `pyramid` (w).
     levels: array<vec4<u32>, 9>,
+    // Each channel's share of the extinction (xyz), and (w) 1 for a
+    // chromatic medium (spectral.wgsl).
+    tint: vec4<f32>,
 }
 
 struct LightRecord {

@@ -90,10 +90,18 @@ fn start_path(x: u32, y: u32, pixel: u32, sample: u32) -> PathState {
 fn advance(st: ptr<function, PathState>, rng: ptr<function, u32>) -> bool {
     let origin = (*st).origin.xyz;
     let dir = (*st).dir.xyz;
-    let flight = free_flight(origin, dir, rng);
-    if (*st).depth == 0u && flight.kind != FLIGHT_ESCAPED {
-        // Alpha: the track-length estimate of 1 - T along the camera ray.
-        (*st).dir.w = 1.0;
+    var weighed = (*st).beta.xyz;
+    let flight = free_flight(origin, dir, &weighed, rng);
+    (*st).beta = vec4<f32>(weighed, 0.0);
+    if (*st).depth == 0u {
+        // Alpha: the track-length estimate of 1 - T along the camera ray
+        // (for a chromatic medium's escape, 1 - avg(beta) with the
+        // flight's weights: spectrum.rs, `escaped_alpha`).
+        var alpha = 1.0;
+        if flight.kind == FLIGHT_ESCAPED {
+            alpha = select(0.0, 1.0 - (weighed.x + weighed.y + weighed.z) / 3.0, chromatic());
+        }
+        (*st).dir.w = alpha;
     }
     if flight.kind == FLIGHT_ESCAPED {
         let e = escape_radiance(dir, (*st).origin.w);
