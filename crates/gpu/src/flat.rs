@@ -15,6 +15,8 @@
 //! - `partition`: the cell partition the CPU's walk reads
 //!   (`crates/bricks/src/partition.rs`), its byte codes four to a word.
 //! - `lights`: tagged records, one a light at infinity.
+//! - `phase_table`: a tabulated phase function's cosines, values and
+//!   sampling CDF (`crates/kernel/src/phase/table.rs`).
 //! - `Params`: the render-to-local transform, the camera's basis, the
 //!   medium (density scale, albedo, HG g), sizes, the window, the seed,
 //!   the walk's majorants and shadow rays' estimator.
@@ -54,7 +56,8 @@ pub struct Params {
     pub phase_b: [f32; 4],
     /// Bricks per axis (xyz), atlas precision (w: 0 f32, 1 f16).
     pub map_dims: [u32; 4],
-    /// Light count (x), stored bricks per atlas chunk (y, set at upload).
+    /// Light count (x), stored bricks per atlas chunk (y, set at upload),
+    /// a tabulated phase function's rows (z).
     pub counts: [u32; 4],
     /// Full image width and height, window origin x0, y0.
     pub image: [u32; 4],
@@ -122,6 +125,8 @@ pub struct FlatScene {
     pub pyramid: Vec<f32>,
     pub partition: Vec<u32>,
     pub lights: Vec<LightRecord>,
+    /// A tabulated phase function's rows (`phase_table`).
+    pub phase_table: Vec<f32>,
 }
 
 impl FlatScene {
@@ -163,6 +168,11 @@ impl FlatScene {
             .collect();
         let pd = partition.dims();
         let (phase, phase_b) = phase_lobes(&medium.phase);
+        let phase_table = phase_table(&medium.phase);
+        let table_rows = match &medium.phase {
+            Phase::Table(t) => t.len() as u32,
+            _ => 0,
+        };
         let (atlas, precision) = atlas_words(volume.atlas());
         let lights: Vec<LightRecord> = lights.iter().filter_map(light_record).collect();
         let extent = volume.local_extent();
@@ -178,7 +188,7 @@ impl FlatScene {
             phase,
             phase_b,
             map_dims: [volume.dims[0], volume.dims[1], volume.dims[2], precision],
-            counts: [lights.len() as u32, 0, 0, 0],
+            counts: [lights.len() as u32, 0, table_rows, 0],
             walk: [
                 partition.voxel_split().min(f32::MAX),
                 volume.max_density(),
@@ -213,6 +223,7 @@ impl FlatScene {
             pyramid: non_empty(pyramid, 0.0),
             partition: non_empty(partition_words, 0),
             lights: non_empty(lights, LightRecord::default()),
+            phase_table,
         }
     }
 
@@ -229,7 +240,11 @@ impl FlatScene {
     /// Bytes of every array uploaded.
     pub fn bytes(&self) -> u64 {
         let lights = self.lights.len() * std::mem::size_of::<LightRecord>();
-        let words = self.map.len() + self.atlas.len() + self.constants.len() + self.pyramid.len();
+        let words = self.map.len()
+            + self.atlas.len()
+            + self.constants.len()
+            + self.pyramid.len()
+            + self.phase_table.len();
         (4 * (words + self.partition.len()) + lights + std::mem::size_of::<Params>()) as u64
     }
 
@@ -241,6 +256,7 @@ impl FlatScene {
             self.constants.len() * 4,
             self.pyramid.len() * 4,
             self.partition.len() * 4,
+            self.phase_table.len() * 4,
             self.lights.len() * std::mem::size_of::<LightRecord>(),
         ]
         .into_iter()
@@ -258,8 +274,9 @@ fn lobe(g: f32, alpha: f32) -> [f32; 4] {
 }
 
 /// `phase` as a blend of two Draine lobes (`shaders/phase.wgsl`), the
-/// first's weight in its `w`: every phase function but a table (refused
-/// before flattening, `support.rs`; it takes HG with g 0 here).
+/// first's weight in its `w`: every phase function but a table, which
+/// flags the second lobe (`w` 1) and keeps its density's scale there
+/// (`x`), its rows in `FlatScene::phase_table`.
 pub fn phase_lobes(phase: &Phase) -> ([f32; 4], [f32; 4]) {
     let (a, b, w) = match phase {
         Phase::Hg(h) => (lobe(h.g(), 0.0), lobe(0.0, 0.0), 1.0),
@@ -273,9 +290,31 @@ pub fn phase_lobes(phase: &Phase) -> ([f32; 4], [f32; 4]) {
             (lobe(a.g(), 0.0), lobe(b.g(), b.alpha()), blend.weight())
         }
         Phase::Rayleigh(_) => (lobe(0.0, 1.0), lobe(0.0, 0.0), 1.0),
-        Phase::Table(_) => (lobe(0.0, 0.0), lobe(0.0, 0.0), 1.0),
+        // The table's own (`shaders/table_phase.wgsl`): its density's
+        // scale over cosines, and the flag.
+        Phase::Table(t) => {
+            let (_, _, _, mu_density) = t.rows();
+            (lobe(0.0, 0.0), [mu_density as f32, 0.0, 0.0, 1.0], 1.0)
+        }
     };
     ([a[0], a[1], a[2], w], b)
+}
+
+/// A tabulated phase function as the kernel reads it: the rows' cosines,
+/// values and sampling CDF one after another (a placeholder for the
+/// others).
+fn phase_table(phase: &Phase) -> Vec<f32> {
+    match phase {
+        Phase::Table(t) => {
+            let (mu, value, cdf, _) = t.rows();
+            let mut words = Vec::with_capacity(3 * mu.len());
+            words.extend_from_slice(mu);
+            words.extend_from_slice(value);
+            words.extend(cdf.iter().map(|&c| c as f32));
+            words
+        }
+        _ => vec![0.0],
+    }
 }
 
 fn walk_mode(mode: MajorantMode) -> u32 {

@@ -12,7 +12,7 @@ use crate::flat::{FlatScene, Params};
 
 /// The kernel's stages, in the order they are joined (WGSL declarations
 /// may come in any order; this is the order to read them in).
-pub const STAGES: [(&str, &str); 9] = [
+pub const STAGES: [(&str, &str); 10] = [
     ("common.wgsl", include_str!("shaders/common.wgsl")),
     ("lookup.wgsl", include_str!("shaders/lookup.wgsl")),
     ("walk.wgsl", include_str!("shaders/walk.wgsl")),
@@ -20,6 +20,7 @@ pub const STAGES: [(&str, &str); 9] = [
     ("delta.wgsl", include_str!("shaders/delta.wgsl")),
     ("ratio.wgsl", include_str!("shaders/ratio.wgsl")),
     ("phase.wgsl", include_str!("shaders/phase.wgsl")),
+    ("table_phase.wgsl", include_str!("shaders/table_phase.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     ("path.wgsl", include_str!("shaders/path.wgsl")),
 ];
@@ -31,10 +32,10 @@ pub const ENTRY: &str = "render_pass";
 const GROUP: u32 = 8;
 
 /// Storage bindings besides the atlas's chunks (`common.wgsl`).
-const OTHER_STORAGE_BINDINGS: u32 = 8;
+const OTHER_STORAGE_BINDINGS: u32 = 9;
 
 /// The binding of the atlas's second chunk (the first is binding 2).
-const FIRST_EXTRA_CHUNK_BINDING: u32 = 10;
+const FIRST_EXTRA_CHUNK_BINDING: u32 = 11;
 
 /// The WGSL module for an atlas in `chunks` bindings: every stage, joined,
 /// and the chunks' declarations.
@@ -95,6 +96,7 @@ struct Buffers {
     paths: wgpu::Buffer,
     pending: wgpu::Buffer,
     partition: wgpu::Buffer,
+    phase_table: wgpu::Buffer,
 }
 
 /// How the atlas is split: stored bricks a chunk, and chunks.
@@ -228,6 +230,11 @@ fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64, split: AtlasSpl
             U::STORAGE,
         ),
         lights: init("lights", bytemuck::cast_slice(&scene.lights), U::STORAGE),
+        phase_table: init(
+            "phase table",
+            bytemuck::cast_slice(&scene.phase_table),
+            U::STORAGE,
+        ),
         film: init(
             "film",
             bytemuck::cast_slice(&film),
@@ -316,6 +323,7 @@ impl<'g> Kernel<'g> {
             &b.paths,
             &b.pending,
             &b.partition,
+            &b.phase_table,
         ];
         bound.extend(&b.atlas[1..]);
         let entries: Vec<wgpu::BindGroupEntry> = bound

@@ -6,8 +6,7 @@ use cirrus_bricks::Precision;
 use cirrus_kernel::medium::BrickField;
 use cirrus_kernel::transform_motion::MovingField;
 use cirrus_render::{
-    IntegratorKind, Light, LightSampling, Phase, RenderSettings, SamplerKind, Scene, Sunward,
-    Volumes,
+    IntegratorKind, Light, LightSampling, RenderSettings, SamplerKind, Scene, Sunward, Volumes,
 };
 
 /// The prepared scene the GPU backend takes: what `cirrus-scene` prepares
@@ -76,9 +75,6 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
         if m.holdout {
             no("holdout volumes");
         }
-        if let Some(phase) = phase_refused(&m.phase) {
-            no(phase);
-        }
         if m.field.still_field().volume().precision() == Precision::U8 {
             no("u8 bricks (f32 or f16 only)");
         }
@@ -86,16 +82,6 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
     out.sort();
     out.dedup();
     out
-}
-
-/// The phase functions the kernel does not have, by name: tables (HG,
-/// two-lobe HG, Draine, the approximate Mie fit and Rayleigh are one
-/// form there, `shaders/phase.wgsl`).
-fn phase_refused(phase: &Phase) -> Option<&'static str> {
-    match phase {
-        Phase::Table(_) => Some("tabulated phase functions"),
-        _ => None,
-    }
 }
 
 /// Where the GPU estimates the same image by other means than `settings`

@@ -195,6 +195,41 @@ fn gpu_agrees_with_cpu_in_a_chromatic_medium_by_track_length() {
     );
 }
 
+/// A tabulated phase function (HG g 0.7 with a backward bump, 121 rows,
+/// unnormalised as a table file may be): the same agreement.
+#[test]
+fn gpu_agrees_with_cpu_under_a_tabulated_phase() {
+    let dir = std::env::temp_dir().join(format!("cirrus-gpu-table-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rows: String = (0..121)
+        .map(|i| {
+            let mu = -1.0 + 2.0 * f64::from(i) / 120.0;
+            let hg = (1.0 - 0.49) / (1.0 + 0.49 - 1.4 * mu).powf(1.5);
+            let bump = 0.5 * (-((mu + 0.9) / 0.1).powi(2)).exp();
+            format!("{mu} {}\n", 3.0 * (hg + bump))
+        })
+        .collect();
+    let table = dir.join("phase.txt");
+    std::fs::write(&table, format!("# cos value\n{rows}")).unwrap();
+    agrees_with_cpu(&format!(
+        r#"
+        [render]
+        max_depth = 4
+        [sun]
+        angle = 0
+        direction = [0.5, -0.3, -0.8]
+        [environment]
+        radiance = [0.2, 0.2, 0.25]
+        [[volume]]
+        file = "cloud.vdb"
+        albedo = 0.9
+        phase = "table:{}"
+        "#,
+        table.display()
+    ));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A backward Draine lobe (g -0.4, alpha 3): the same agreement.
 #[test]
 fn gpu_agrees_with_cpu_under_a_backward_draine_phase() {

@@ -20,7 +20,8 @@ struct Params {
     phase: vec4<f32>,
     phase_b: vec4<f32>,
     map_dims: vec4<u32>,
-    // Lights (x), stored bricks per atlas chunk (y).
+    // Lights (x), stored bricks per atlas chunk (y), a tabulated phase
+    // function's rows (z).
     counts: vec4<u32>,
     image: vec4<u32>,
     window: vec4<u32>,
@@ -87,7 +88,7 @@ struct PathState {
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> brick_map: array<u32>;
-// The atlas's first chunk; the others (`atlas_1`, ...: bindings 10 on)
+// The atlas's first chunk; the others (`atlas_1`, ...: bindings 11 on)
 // and `atlas_word`, which reads any, are written by the host for the
 // chunks a scene needs (kernel.rs, `atlas_chunks_source`).
 @group(0) @binding(2) var<storage, read> atlas_0: array<u32>;
@@ -102,6 +103,8 @@ struct PathState {
 @group(0) @binding(8) var<storage, read_write> pending: array<atomic<u32>>;
 // The cell partition's codes, a byte a level-1 cell, four to a word.
 @group(0) @binding(9) var<storage, read> cell_codes: array<u32>;
+// A tabulated phase function's cosines, values and CDF (table_phase.wgsl).
+@group(0) @binding(10) var<storage, read> phase_table: array<f32>;
 
 // Set where a loop was left other than by its own exits: lavapipe
 // (llvmpipe) ends every loop once an invocation has run 65535 iterations
