@@ -1,15 +1,16 @@
 //! The path tracer on a GPU: `cirrus-kernel`'s unbiased volume path
 //! tracing (delta tracking over the majorant hierarchy, shadow rays by
 //! residual ratio, ratio or track-length estimation, next-event
-//! estimation with MIS, Henyey-Greenstein scattering, Russian roulette)
+//! estimation with MIS, every phase function, chromatic media by spectral
+//! tracking, Russian roulette)
 //! as one WGSL compute kernel run through `wgpu` on Vulkan, for the scenes
 //! it can render exactly, and a refusal naming everything else.
 //!
 //! How the parts fit:
 //!
 //! - `support.rs`: what the kernel renders ([`unsupported`] names the
-//!   rest: other integrators and lights, other phase functions, chromatic
-//!   or emitting media, motion, several volumes, AOVs and compositing
+//!   rest: other integrators and lights, emitting media, u8 bricks,
+//!   motion, several volumes, AOVs and compositing
 //!   layers, adaptive sampling, denoising), and where it reaches the same
 //!   expectation by other estimators than the settings name
 //!   ([`substitutions`]: random numbers, every light at each vertex, no sunward
@@ -23,10 +24,11 @@
 //! - `device.rs`: the adapter ([`open`]; the `device` setting that
 //!   chooses it is `cirrus_scene::Device`) and [`GpuError`].
 //! - `kernel.rs` and `shaders/`: the megakernel, one WGSL file a stage
-//!   (`lookup`, `walk`, `delta`, `ratio`, `lights`, `path`), each citing
-//!   the CPU code it mirrors; the scene uploaded once, one pass a sample
-//!   per pixel, each pixel's running moments kept on the device by the one
-//!   invocation that owns it.
+//!   (`lookup`, `walk`, `spectral`, `delta`, `ratio`, `phase`,
+//!   `table_phase`, `lights`, `path`), each citing
+//!   the CPU code it mirrors; the scene uploaded once, each pixel's path
+//!   and running moments kept on the device by the one invocation that
+//!   owns it, a window whose paths exceed a binding rendered band by band.
 //! - [`render`] reads the moments back into the host's film
 //!   ([`cirrus_render::PassFilm`]), so the image resolves and writes
 //!   (EXR, PNG) exactly as a CPU render's does.
