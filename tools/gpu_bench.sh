@@ -64,8 +64,9 @@ for scene in thick default sky; do
   unset -n args
 done
 frame=(data/cloud.vdb --res 1920x1080 --spp 1 --device gpu)
-# A device whose bindings cannot hold a 1080p frame's paths (lavapipe's
-# 128 MiB) refuses it: said, and the other figures still printed.
+# A frame whose paths exceed a binding (lavapipe's 128 MiB) renders in
+# bands of rows; a device that refuses it anyway is said, and the other
+# figures still printed.
 for _ in $(seq "$rounds"); do
   if ! "$bin" render "${frame[@]}" -o "$out/frame.exr" --stats "$out/frame.json" 2>"$out/frame.log" >/dev/null; then
     echo "1920x1080 frame not timed: $(grep -v 'rendering on' "$out/frame.log" | tail -1)"

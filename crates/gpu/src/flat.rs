@@ -15,6 +15,8 @@
 //! - `partition`: the cell partition the CPU's walk reads
 //!   (`crates/bricks/src/partition.rs`), its byte codes four to a word.
 //! - `lights`: tagged records, one a light at infinity.
+//! - `phase_table`: a tabulated phase function's cosines, values and
+//!   sampling CDF (`crates/kernel/src/phase/table.rs`).
 //! - `Params`: the render-to-local transform, the camera's basis, the
 //!   medium (density scale, albedo, HG g), sizes, the window, the seed,
 //!   the walk's majorants and shadow rays' estimator.
@@ -54,7 +56,8 @@ pub struct Params {
     pub phase_b: [f32; 4],
     /// Bricks per axis (xyz), atlas precision (w: 0 f32, 1 f16).
     pub map_dims: [u32; 4],
-    /// Light count (x), stored bricks per atlas chunk (y, set at upload).
+    /// Light count (x), stored bricks per atlas chunk (y, set at upload),
+    /// a tabulated phase function's rows (z).
     pub counts: [u32; 4],
     /// Full image width and height, window origin x0, y0.
     pub image: [u32; 4],
@@ -66,13 +69,22 @@ pub struct Params {
     /// the volume's largest density (y).
     pub walk: [f32; 4],
     /// Majorants (x: [`WALK_HIERARCHY`] or [`WALK_GLOBAL`]), shadow rays'
-    /// estimator (y: `TRANSMITTANCE_*`).
+    /// estimator (y: `TRANSMITTANCE_*`), [`VOXEL_CELL_CORNERS`] (z).
     pub walk_mode: [u32; 4],
     /// Level-1 cells of the partition per axis.
     pub part_dims: [u32; 4],
     /// Per pyramid level: cells per axis, its first float in `pyramid`.
     pub levels: [[u32; 4]; MAX_LEVELS],
+    /// Each channel's share of the extinction (xyz, the medium's
+    /// `extinction_tint`), and (w) 1 where it is chromatic (tracked per
+    /// channel, `shaders/spectral.wgsl`), 0 where grey.
+    pub tint: [f32; 4],
 }
+
+/// The corners of a voxel cell, a parameter rather than a constant in the
+/// kernel so that its loops over them stay rolled (`corners` in
+/// `shaders/common.wgsl` says why).
+pub const VOXEL_CELL_CORNERS: u32 = 8;
 
 /// Majorant modes (`shaders/walk.wgsl`).
 pub const WALK_HIERARCHY: u32 = 0;
@@ -113,6 +125,8 @@ pub struct FlatScene {
     pub pyramid: Vec<f32>,
     pub partition: Vec<u32>,
     pub lights: Vec<LightRecord>,
+    /// A tabulated phase function's rows (`phase_table`).
+    pub phase_table: Vec<f32>,
 }
 
 impl FlatScene {
@@ -154,6 +168,11 @@ impl FlatScene {
             .collect();
         let pd = partition.dims();
         let (phase, phase_b) = phase_lobes(&medium.phase);
+        let phase_table = phase_table(&medium.phase);
+        let table_rows = match &medium.phase {
+            Phase::Table(t) => t.len() as u32,
+            _ => 0,
+        };
         let (atlas, precision) = atlas_words(volume.atlas());
         let lights: Vec<LightRecord> = lights.iter().filter_map(light_record).collect();
         let extent = volume.local_extent();
@@ -169,7 +188,7 @@ impl FlatScene {
             phase,
             phase_b,
             map_dims: [volume.dims[0], volume.dims[1], volume.dims[2], precision],
-            counts: [lights.len() as u32, 0, 0, 0],
+            counts: [lights.len() as u32, 0, table_rows, 0],
             walk: [
                 partition.voxel_split().min(f32::MAX),
                 volume.max_density(),
@@ -179,11 +198,21 @@ impl FlatScene {
             walk_mode: [
                 walk_mode(walk.majorant),
                 estimator(walk.transmittance),
-                0,
+                VOXEL_CELL_CORNERS,
                 0,
             ],
             part_dims: [pd[0], pd[1], pd[2], 0],
             levels,
+            tint: [
+                medium.extinction_tint.x,
+                medium.extinction_tint.y,
+                medium.extinction_tint.z,
+                if medium.extinction_tint == Vec3::ONE {
+                    0.0
+                } else {
+                    1.0
+                },
+            ],
             ..camera_params(camera)
         };
         Self {
@@ -194,6 +223,7 @@ impl FlatScene {
             pyramid: non_empty(pyramid, 0.0),
             partition: non_empty(partition_words, 0),
             lights: non_empty(lights, LightRecord::default()),
+            phase_table,
         }
     }
 
@@ -210,7 +240,11 @@ impl FlatScene {
     /// Bytes of every array uploaded.
     pub fn bytes(&self) -> u64 {
         let lights = self.lights.len() * std::mem::size_of::<LightRecord>();
-        let words = self.map.len() + self.atlas.len() + self.constants.len() + self.pyramid.len();
+        let words = self.map.len()
+            + self.atlas.len()
+            + self.constants.len()
+            + self.pyramid.len()
+            + self.phase_table.len();
         (4 * (words + self.partition.len()) + lights + std::mem::size_of::<Params>()) as u64
     }
 
@@ -222,6 +256,7 @@ impl FlatScene {
             self.constants.len() * 4,
             self.pyramid.len() * 4,
             self.partition.len() * 4,
+            self.phase_table.len() * 4,
             self.lights.len() * std::mem::size_of::<LightRecord>(),
         ]
         .into_iter()
@@ -239,8 +274,9 @@ fn lobe(g: f32, alpha: f32) -> [f32; 4] {
 }
 
 /// `phase` as a blend of two Draine lobes (`shaders/phase.wgsl`), the
-/// first's weight in its `w`: every phase function but a table (refused
-/// before flattening, `support.rs`; it takes HG with g 0 here).
+/// first's weight in its `w`: every phase function but a table, which
+/// flags the second lobe (`w` 1) and keeps its density's scale there
+/// (`x`), its rows in `FlatScene::phase_table`.
 pub fn phase_lobes(phase: &Phase) -> ([f32; 4], [f32; 4]) {
     let (a, b, w) = match phase {
         Phase::Hg(h) => (lobe(h.g(), 0.0), lobe(0.0, 0.0), 1.0),
@@ -254,9 +290,31 @@ pub fn phase_lobes(phase: &Phase) -> ([f32; 4], [f32; 4]) {
             (lobe(a.g(), 0.0), lobe(b.g(), b.alpha()), blend.weight())
         }
         Phase::Rayleigh(_) => (lobe(0.0, 1.0), lobe(0.0, 0.0), 1.0),
-        Phase::Table(_) => (lobe(0.0, 0.0), lobe(0.0, 0.0), 1.0),
+        // The table's own (`shaders/table_phase.wgsl`): its density's
+        // scale over cosines, and the flag.
+        Phase::Table(t) => {
+            let (_, _, _, mu_density) = t.rows();
+            (lobe(0.0, 0.0), [mu_density as f32, 0.0, 0.0, 1.0], 1.0)
+        }
     };
     ([a[0], a[1], a[2], w], b)
+}
+
+/// A tabulated phase function as the kernel reads it: the rows' cosines,
+/// values and sampling CDF one after another (a placeholder for the
+/// others).
+fn phase_table(phase: &Phase) -> Vec<f32> {
+    match phase {
+        Phase::Table(t) => {
+            let (mu, value, cdf, _) = t.rows();
+            let mut words = Vec::with_capacity(3 * mu.len());
+            words.extend_from_slice(mu);
+            words.extend_from_slice(value);
+            words.extend(cdf.iter().map(|&c| c as f32));
+            words
+        }
+        _ => vec![0.0],
+    }
 }
 
 fn walk_mode(mode: MajorantMode) -> u32 {

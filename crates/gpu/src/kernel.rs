@@ -12,13 +12,15 @@ use crate::flat::{FlatScene, Params};
 
 /// The kernel's stages, in the order they are joined (WGSL declarations
 /// may come in any order; this is the order to read them in).
-pub const STAGES: [(&str, &str); 8] = [
+pub const STAGES: [(&str, &str); 10] = [
     ("common.wgsl", include_str!("shaders/common.wgsl")),
     ("lookup.wgsl", include_str!("shaders/lookup.wgsl")),
     ("walk.wgsl", include_str!("shaders/walk.wgsl")),
+    ("spectral.wgsl", include_str!("shaders/spectral.wgsl")),
     ("delta.wgsl", include_str!("shaders/delta.wgsl")),
     ("ratio.wgsl", include_str!("shaders/ratio.wgsl")),
     ("phase.wgsl", include_str!("shaders/phase.wgsl")),
+    ("table_phase.wgsl", include_str!("shaders/table_phase.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     ("path.wgsl", include_str!("shaders/path.wgsl")),
 ];
@@ -30,10 +32,10 @@ pub const ENTRY: &str = "render_pass";
 const GROUP: u32 = 8;
 
 /// Storage bindings besides the atlas's chunks (`common.wgsl`).
-const OTHER_STORAGE_BINDINGS: u32 = 8;
+const OTHER_STORAGE_BINDINGS: u32 = 9;
 
 /// The binding of the atlas's second chunk (the first is binding 2).
-const FIRST_EXTRA_CHUNK_BINDING: u32 = 10;
+const FIRST_EXTRA_CHUNK_BINDING: u32 = 11;
 
 /// The WGSL module for an atlas in `chunks` bindings: every stage, joined,
 /// and the chunks' declarations.
@@ -94,6 +96,7 @@ struct Buffers {
     paths: wgpu::Buffer,
     pending: wgpu::Buffer,
     partition: wgpu::Buffer,
+    phase_table: wgpu::Buffer,
 }
 
 /// How the atlas is split: stored bricks a chunk, and chunks.
@@ -130,9 +133,30 @@ fn split_atlas(gpu: &Gpu, scene: &FlatScene) -> Result<AtlasSplit, GpuError> {
     })
 }
 
-/// Refuses a scene or window whose arrays exceed what a binding holds or
-/// whose buffers together exceed the device's memory, before anything is
-/// uploaded.
+/// Rows of the window a band of it holds: as many as keep a band's paths
+/// (the larger per-pixel array) within one binding.
+fn band_rows(gpu: &Gpu, width: u32, height: u32) -> Result<u32, GpuError> {
+    let row_bytes = u64::from(width) * PATH_STATE_BYTES;
+    let rows = gpu.max_binding / row_bytes.max(1);
+    if rows == 0 {
+        return Err(GpuError::Device(format!(
+            "a {width}-pixel row needs {row_bytes} bytes of paths and the device binds at most \
+             {} bytes",
+            gpu.max_binding
+        )));
+    }
+    Ok(rows.min(u64::from(height.max(1))) as u32)
+}
+
+/// Bands a `width` x `height` window is rendered in on `gpu`: one where
+/// its paths fit a binding.
+pub fn window_bands(gpu: &Gpu, width: u32, height: u32) -> Result<u32, GpuError> {
+    Ok(height.div_ceil(band_rows(gpu, width, height)?).max(1))
+}
+
+/// Refuses a scene whose arrays exceed what a binding holds or whose
+/// buffers together (the film and paths of a band of `pixels`) exceed the
+/// device's memory, before anything is uploaded.
 fn check_sizes(gpu: &Gpu, scene: &FlatScene, pixels: u64) -> Result<(), GpuError> {
     let largest = scene.largest_binding();
     if largest > gpu.max_binding {
@@ -154,19 +178,11 @@ fn check_sizes(gpu: &Gpu, scene: &FlatScene, pixels: u64) -> Result<(), GpuError
             gpu.memory >> 20
         )));
     }
-    // The paths under way are the larger per-pixel array.
-    let path_bytes = pixels * PATH_STATE_BYTES;
-    if path_bytes > gpu.max_binding {
-        return Err(GpuError::Device(format!(
-            "a {pixels}-pixel window needs {} MiB of paths and the device binds at most {} MiB",
-            path_bytes >> 20,
-            gpu.max_binding >> 20
-        )));
-    }
     Ok(())
 }
 
-/// The scene uploaded, the film zeroed and the paths' room made.
+/// The scene uploaded, the film zeroed and the paths' room made, for a
+/// band of `pixels`.
 fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64, split: AtlasSplit) -> Buffers {
     use wgpu::BufferUsages as U;
     let init = |label: &str, bytes: &[u8], usage: U| {
@@ -214,27 +230,52 @@ fn upload(device: &wgpu::Device, scene: &FlatScene, pixels: u64, split: AtlasSpl
             U::STORAGE,
         ),
         lights: init("lights", bytemuck::cast_slice(&scene.lights), U::STORAGE),
+        phase_table: init(
+            "phase table",
+            bytemuck::cast_slice(&scene.phase_table),
+            U::STORAGE,
+        ),
         film: init(
             "film",
             bytemuck::cast_slice(&film),
-            U::STORAGE | U::COPY_SRC,
+            U::STORAGE | U::COPY_SRC | U::COPY_DST,
         ),
         // Zero-filled at creation: no path under way, no sample taken.
-        paths: empty("paths", pixels * PATH_STATE_BYTES, U::STORAGE),
+        paths: empty("paths", pixels * PATH_STATE_BYTES, U::STORAGE | U::COPY_DST),
         pending: empty("pending", 4, U::STORAGE | U::COPY_SRC | U::COPY_DST),
     }
 }
 
-/// The uploaded scene, the film on the device and the pipeline.
+/// A band of the window's rows, rendered by itself: its first row (from
+/// the window's top) and its rows.
+#[derive(Clone, Copy, Debug)]
+struct Band {
+    y0: u32,
+    rows: u32,
+}
+
+/// The uploaded scene, the film and paths of one band of the window on
+/// the device, and the pipeline. A window whose paths exceed a binding is
+/// rendered band by band (each pixel's samples keyed by its place in the
+/// image, so the bands make the unsplit image, bit for bit); the
+/// moments of the bands not on the device wait on the host.
 pub struct Kernel<'g> {
     gpu: &'g Gpu,
     params: Params,
     params_buffer: wgpu::Buffer,
     film: wgpu::Buffer,
+    paths: wgpu::Buffer,
     pending: wgpu::Buffer,
-    pixels: u64,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    /// The window's top row in the image.
+    window_y0: u32,
+    width: u32,
+    bands: Vec<Band>,
+    /// The band on the device.
+    current: usize,
+    /// Every band's moments while several take turns on the device.
+    host_film: Vec<PixelSlot>,
 }
 
 impl<'g> Kernel<'g> {
@@ -242,8 +283,15 @@ impl<'g> Kernel<'g> {
     /// a binding may be.
     pub fn new(gpu: &'g Gpu, scene: &FlatScene) -> Result<Self, GpuError> {
         let [w, h] = [scene.params.window[0], scene.params.window[1]];
-        let pixels = u64::from(w) * u64::from(h);
+        let rows = band_rows(gpu, w, h)?;
+        let pixels = u64::from(w) * u64::from(rows);
         check_sizes(gpu, scene, pixels)?;
+        let bands: Vec<Band> = (0..h.div_ceil(rows).max(1))
+            .map(|k| Band {
+                y0: k * rows,
+                rows: rows.min(h - k * rows),
+            })
+            .collect();
         let split = split_atlas(gpu, scene)?;
         let mut params = scene.params;
         params.counts[1] = split.bricks_per_chunk as u32;
@@ -275,6 +323,7 @@ impl<'g> Kernel<'g> {
             &b.paths,
             &b.pending,
             &b.partition,
+            &b.phase_table,
         ];
         bound.extend(&b.atlas[1..]);
         let entries: Vec<wgpu::BindGroupEntry> = bound
@@ -293,16 +342,83 @@ impl<'g> Kernel<'g> {
         if let Some(e) = block_on(scope.pop()) {
             return Err(GpuError::Device(format!("the kernel was refused: {e}")));
         }
-        Ok(Self {
+        let host_film = if bands.len() > 1 {
+            vec![PixelSlot::default(); w as usize * h as usize]
+        } else {
+            Vec::new()
+        };
+        let mut kernel = Self {
             gpu,
             params,
             params_buffer: b.params,
             film: b.film,
+            paths: b.paths,
             pending: b.pending,
-            pixels,
             pipeline,
             bind_group,
-        })
+            window_y0: scene.params.image[3],
+            width: w,
+            bands,
+            current: 0,
+            host_film,
+        };
+        kernel.place_band(0);
+        Ok(kernel)
+    }
+
+    /// Bands the window is rendered in.
+    pub fn bands(&self) -> usize {
+        self.bands.len()
+    }
+
+    /// Puts band `k` on the device: its rows in the parameters, and where
+    /// the window is split, its moments so far in the film and no path
+    /// under way (each pixel's next sample is its count of samples,
+    /// `path.wgsl`).
+    pub fn enter_band(&mut self, k: usize) -> Result<(), GpuError> {
+        if self.bands.len() == 1 {
+            return Ok(());
+        }
+        self.place_band(k);
+        let range = self.band_slots(k);
+        self.gpu
+            .queue
+            .write_buffer(&self.film, 0, bytemuck::cast_slice(&self.host_film[range]));
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("band"),
+            });
+        encoder.clear_buffer(&self.paths, 0, None);
+        self.gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// Keeps the moments of the band on the device on the host (where the
+    /// window is split), once its pixels are done.
+    pub fn leave_band(&mut self) -> Result<(), GpuError> {
+        if self.bands.len() == 1 {
+            return Ok(());
+        }
+        let range = self.band_slots(self.current);
+        let slots = self.read_band_film(range.len())?;
+        self.host_film[range].copy_from_slice(&slots);
+        Ok(())
+    }
+
+    fn place_band(&mut self, k: usize) {
+        let band = self.bands[k];
+        self.current = k;
+        self.params.image[3] = self.window_y0 + band.y0;
+        self.params.window[1] = band.rows;
+    }
+
+    /// Band `k`'s slots in the window's film.
+    fn band_slots(&self, k: usize) -> std::ops::Range<usize> {
+        let band = self.bands[k];
+        let w = self.width as usize;
+        band.y0 as usize * w..(band.y0 + band.rows) as usize * w
     }
 
     /// Queues a dispatch: each pixel with fewer than `target` samples
@@ -342,9 +458,18 @@ impl<'g> Kernel<'g> {
             .map_err(|e| GpuError::Device(format!("waiting for a pass: {e}")))
     }
 
-    /// The film's moments, read back (after every dispatch queued).
+    /// The window's moments (after every dispatch queued): the film on
+    /// the device, or the bands' kept on the host.
     pub fn read_film(&self) -> Result<Vec<PixelSlot>, GpuError> {
-        let bytes = self.pixels * std::mem::size_of::<PixelSlot>() as u64;
+        if self.bands.len() > 1 {
+            return Ok(self.host_film.clone());
+        }
+        self.read_band_film(self.band_slots(0).len())
+    }
+
+    /// The first `pixels` slots of the film on the device.
+    fn read_band_film(&self, pixels: usize) -> Result<Vec<PixelSlot>, GpuError> {
+        let bytes = (pixels * std::mem::size_of::<PixelSlot>()) as u64;
         let raw = self.read(&self.film, bytes)?;
         Ok(bytemuck::cast_slice::<u8, PixelSlot>(&raw).to_vec())
     }

@@ -1,15 +1,16 @@
 //! The path tracer on a GPU: `cirrus-kernel`'s unbiased volume path
 //! tracing (delta tracking over the majorant hierarchy, shadow rays by
 //! residual ratio, ratio or track-length estimation, next-event
-//! estimation with MIS, Henyey-Greenstein scattering, Russian roulette)
+//! estimation with MIS, every phase function, chromatic media by spectral
+//! tracking, Russian roulette)
 //! as one WGSL compute kernel run through `wgpu` on Vulkan, for the scenes
 //! it can render exactly, and a refusal naming everything else.
 //!
 //! How the parts fit:
 //!
 //! - `support.rs`: what the kernel renders ([`unsupported`] names the
-//!   rest: other integrators and lights, other phase functions, chromatic
-//!   or emitting media, motion, several volumes, AOVs and compositing
+//!   rest: other integrators and lights, emitting media, u8 bricks,
+//!   motion, several volumes, AOVs and compositing
 //!   layers, adaptive sampling, denoising), and where it reaches the same
 //!   expectation by other estimators than the settings name
 //!   ([`substitutions`]: random numbers, every light at each vertex, no sunward
@@ -23,10 +24,11 @@
 //! - `device.rs`: the adapter ([`open`]; the `device` setting that
 //!   chooses it is `cirrus_scene::Device`) and [`GpuError`].
 //! - `kernel.rs` and `shaders/`: the megakernel, one WGSL file a stage
-//!   (`lookup`, `walk`, `delta`, `ratio`, `lights`, `path`), each citing
-//!   the CPU code it mirrors; the scene uploaded once, one pass a sample
-//!   per pixel, each pixel's running moments kept on the device by the one
-//!   invocation that owns it.
+//!   (`lookup`, `walk`, `spectral`, `delta`, `ratio`, `phase`,
+//!   `table_phase`, `lights`, `path`), each citing
+//!   the CPU code it mirrors; the scene uploaded once, each pixel's path
+//!   and running moments kept on the device by the one invocation that
+//!   owns it, a window whose paths exceed a binding rendered band by band.
 //! - [`render`] reads the moments back into the host's film
 //!   ([`cirrus_render::PassFilm`]), so the image resolves and writes
 //!   (EXR, PNG) exactly as a CPU render's does.
@@ -48,7 +50,7 @@ use cirrus_render::{
 
 pub use device::{open, Gpu, GpuError, INSTALL_HINT};
 pub use flat::{FlatScene, LightRecord, Params, WalkChoice};
-pub use kernel::{source, PixelSlot, STAGES};
+pub use kernel::{source, window_bands, PixelSlot, STAGES};
 pub use support::{substitutions, unsupported, PreparedScene};
 
 /// Renders `scene` with `settings` on `gpu`, or says why not: what the
@@ -138,16 +140,22 @@ const EVENTS_PER_DISPATCH: u32 = 4096;
 /// Dispatches queued between checks of whether every pixel is done.
 const DISPATCHES_PER_CHECK: u32 = 8;
 
-/// Dispatches until every pixel has `target` samples.
+/// Dispatches until every pixel has `target` samples, band after band
+/// of the window where its paths exceed a binding.
 fn run_to(kernel: &mut kernel::Kernel, target: u32) -> Result<(), GpuError> {
-    loop {
-        for _ in 0..DISPATCHES_PER_CHECK {
-            kernel.dispatch(target, EVENTS_PER_DISPATCH);
+    for band in 0..kernel.bands() {
+        kernel.enter_band(band)?;
+        loop {
+            for _ in 0..DISPATCHES_PER_CHECK {
+                kernel.dispatch(target, EVENTS_PER_DISPATCH);
+            }
+            if kernel.pending()? == 0 {
+                break;
+            }
         }
-        if kernel.pending()? == 0 {
-            return Ok(());
-        }
+        kernel.leave_band()?;
     }
+    Ok(())
 }
 
 /// The flat form of `scene` for `film`'s window and `settings`' seed and

@@ -6,8 +6,7 @@ use cirrus_bricks::Precision;
 use cirrus_kernel::medium::BrickField;
 use cirrus_kernel::transform_motion::MovingField;
 use cirrus_render::{
-    IntegratorKind, Light, LightSampling, Phase, RenderSettings, SamplerKind, Scene, Sunward,
-    Volumes,
+    IntegratorKind, Light, LightSampling, RenderSettings, SamplerKind, Scene, Sunward, Volumes,
 };
 
 /// The prepared scene the GPU backend takes: what `cirrus-scene` prepares
@@ -70,17 +69,11 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
         if m.field.moves() || m.field.still_field().moves() {
             no("volume motion blur");
         }
-        if m.extinction_tint != glam::Vec3::ONE {
-            no("chromatic media (a density scale per channel)");
-        }
         if m.emission.is_some() {
             no("emission");
         }
         if m.holdout {
             no("holdout volumes");
-        }
-        if let Some(phase) = phase_refused(&m.phase) {
-            no(phase);
         }
         if m.field.still_field().volume().precision() == Precision::U8 {
             no("u8 bricks (f32 or f16 only)");
@@ -89,16 +82,6 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
     out.sort();
     out.dedup();
     out
-}
-
-/// The phase functions the kernel does not have, by name: tables (HG,
-/// two-lobe HG, Draine, the approximate Mie fit and Rayleigh are one
-/// form there, `shaders/phase.wgsl`).
-fn phase_refused(phase: &Phase) -> Option<&'static str> {
-    match phase {
-        Phase::Table(_) => Some("tabulated phase functions"),
-        _ => None,
-    }
 }
 
 /// Where the GPU estimates the same image by other means than `settings`

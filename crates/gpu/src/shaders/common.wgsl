@@ -20,7 +20,8 @@ struct Params {
     phase: vec4<f32>,
     phase_b: vec4<f32>,
     map_dims: vec4<u32>,
-    // Lights (x), stored bricks per atlas chunk (y).
+    // Lights (x), stored bricks per atlas chunk (y), a tabulated phase
+    // function's rows (z).
     counts: vec4<u32>,
     image: vec4<u32>,
     window: vec4<u32>,
@@ -29,13 +30,17 @@ struct Params {
     // voxel by voxel (x), the volume's largest density (y).
     walk: vec4<f32>,
     // Majorants (x: 0 the hierarchy, 1 one global bound), shadow rays'
-    // estimator (y: ratio.wgsl's TRANSMITTANCE_*).
+    // estimator (y: ratio.wgsl's TRANSMITTANCE_*), the corners of a
+    // voxel cell (z: 8, see `corners`).
     walk_mode: vec4<u32>,
     // Level-1 cells of the partition per axis (xyz).
     part_dims: vec4<u32>,
     // Per pyramid level: cells per axis (xyz), its first float in
     // `pyramid` (w).
     levels: array<vec4<u32>, 9>,
+    // Each channel's share of the extinction (xyz), and (w) 1 for a
+    // chromatic medium (spectral.wgsl).
+    tint: vec4<f32>,
 }
 
 struct LightRecord {
@@ -83,7 +88,7 @@ struct PathState {
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> brick_map: array<u32>;
-// The atlas's first chunk; the others (`atlas_1`, ...: bindings 10 on)
+// The atlas's first chunk; the others (`atlas_1`, ...: bindings 11 on)
 // and `atlas_word`, which reads any, are written by the host for the
 // chunks a scene needs (kernel.rs, `atlas_chunks_source`).
 @group(0) @binding(2) var<storage, read> atlas_0: array<u32>;
@@ -98,6 +103,8 @@ struct PathState {
 @group(0) @binding(8) var<storage, read_write> pending: array<atomic<u32>>;
 // The cell partition's codes, a byte a level-1 cell, four to a word.
 @group(0) @binding(9) var<storage, read> cell_codes: array<u32>;
+// A tabulated phase function's cosines, values and CDF (table_phase.wgsl).
+@group(0) @binding(10) var<storage, read> phase_table: array<f32>;
 
 // Set where a loop was left other than by its own exits: lavapipe
 // (llvmpipe) ends every loop once an invocation has run 65535 iterations
@@ -115,6 +122,18 @@ const ITERATION_BUDGET: u32 = 32768u;
 var<private> real_collisions: u32;
 var<private> null_collisions: u32;
 var<private> shadow_collisions: u32;
+
+// The corners of a voxel cell, 8, read from the parameters so that no
+// compiler unrolls a loop over them. Lavapipe (llvmpipe) runs a branch
+// that any invocation of a SIMD batch takes with all of them masked, so
+// every voxel lookup written out in a loop's body costs each turn of that
+// loop whether taken or not; a loop whose trip count it cannot see stays
+// one lookup long (and is skipped where no invocation enters it). Eight
+// lookups unrolled into the walk's thick-cell branch and the trilinear
+// filter made the kernel 2-3 times slower there.
+fn corners() -> i32 {
+    return i32(params.walk_mode.z);
+}
 
 const PI: f32 = 3.14159265358979;
 const FAR: f32 = 3.0e38;

@@ -55,7 +55,9 @@ fn voxel(c: vec3<i32>) -> f32 {
     }
 }
 
-// Trilinear density at local point `p` (voxel centres at integers).
+// Trilinear density at local point `p` (voxel centres at integers): the
+// eight corners' values by their weights, one corner a turn of a loop the
+// compiler cannot unroll (common.wgsl, `corners`).
 fn density(p: vec3<f32>) -> f32 {
     // Far outside (or not a number): nothing, as the CPU's lookup.
     if !(all(abs(p) < vec3<f32>(1.0e9))) {
@@ -64,17 +66,14 @@ fn density(p: vec3<f32>) -> f32 {
     let fl = floor(p);
     let c = vec3<i32>(fl);
     let f = p - fl;
-    let x0 = mix(
-        mix(voxel(c), voxel(c + vec3<i32>(0, 0, 1)), f.z),
-        mix(voxel(c + vec3<i32>(0, 1, 0)), voxel(c + vec3<i32>(0, 1, 1)), f.z),
-        f.y
-    );
-    let x1 = mix(
-        mix(voxel(c + vec3<i32>(1, 0, 0)), voxel(c + vec3<i32>(1, 0, 1)), f.z),
-        mix(voxel(c + vec3<i32>(1, 1, 0)), voxel(c + vec3<i32>(1, 1, 1)), f.z),
-        f.y
-    );
-    return mix(x0, x1, f.x);
+    var sum = 0.0;
+    for (var k = 0; k < corners(); k++) {
+        iterations += 1u;
+        let o = vec3<i32>((k >> 2u) & 1, (k >> 1u) & 1, k & 1);
+        let weight = select(vec3<f32>(1.0) - f, f, o == vec3<i32>(1));
+        sum += weight.x * weight.y * weight.z * voxel(c + o);
+    }
+    return sum;
 }
 
 // Extinction at local point `p`.

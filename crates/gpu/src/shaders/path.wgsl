@@ -90,10 +90,18 @@ fn start_path(x: u32, y: u32, pixel: u32, sample: u32) -> PathState {
 fn advance(st: ptr<function, PathState>, rng: ptr<function, u32>) -> bool {
     let origin = (*st).origin.xyz;
     let dir = (*st).dir.xyz;
-    let flight = free_flight(origin, dir, rng);
-    if (*st).depth == 0u && flight.kind != FLIGHT_ESCAPED {
-        // Alpha: the track-length estimate of 1 - T along the camera ray.
-        (*st).dir.w = 1.0;
+    var weighed = (*st).beta.xyz;
+    let flight = free_flight(origin, dir, &weighed, rng);
+    (*st).beta = vec4<f32>(weighed, 0.0);
+    if (*st).depth == 0u {
+        // Alpha: the track-length estimate of 1 - T along the camera ray
+        // (for a chromatic medium's escape, 1 - avg(beta) with the
+        // flight's weights: spectrum.rs, `escaped_alpha`).
+        var alpha = 1.0;
+        if flight.kind == FLIGHT_ESCAPED {
+            alpha = select(0.0, 1.0 - (weighed.x + weighed.y + weighed.z) / 3.0, chromatic());
+        }
+        (*st).dir.w = alpha;
     }
     if flight.kind == FLIGHT_ESCAPED {
         let e = escape_radiance(dir, (*st).origin.w);
@@ -160,10 +168,15 @@ fn render_pass(@builtin(global_invocation_id) id: vec3<u32>) {
     let slot = id.y * size.x + id.x;
     let target_samples = params.window.z;
     var st = paths[slot];
+    var acc = film[slot];
+    // Between paths, the next sample is the count taken: the host may
+    // have cleared the paths (a window rendered band by band, kernel.rs).
+    if st.under_way == 0u {
+        st.sample = acc.n;
+    }
     if st.sample >= target_samples {
         return;
     }
-    var acc = film[slot];
     if st.under_way == 0u {
         st = start_path(x, y, pixel, st.sample);
     }

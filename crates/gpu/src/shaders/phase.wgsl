@@ -1,4 +1,5 @@
-// The phase functions every medium but a tabulated one scatters with, as
+// The phase functions every medium scatters with: a table
+// (table_phase.wgsl), or, for every other, as
 // one form: a blend `w A + (1 - w) B` of two Draine lobes
 // `HG_g(mu) (1 + alpha mu^2) / (1 + alpha (1 + 2 g^2) / 3)`, which is
 // Henyey-Greenstein at alpha = 0 and Rayleigh at g = 0, alpha = 1. So HG,
@@ -64,6 +65,9 @@ fn lobe_sample_cos(lobe: vec4<f32>, u: f32, rng: ptr<function, u32>) -> f32 {
 
 // The medium's phase function at scattering-angle cosine `mu`.
 fn phase_eval(mu: f32) -> f32 {
+    if is_table_phase() {
+        return table_eval(mu);
+    }
     let w = params.phase.w;
     return w * lobe_eval(params.phase, mu) + (1.0 - w) * lobe_eval(params.phase_b, mu);
 }
@@ -73,7 +77,9 @@ fn phase_sample(dir_in: vec3<f32>, rng: ptr<function, u32>) -> vec4<f32> {
     let u = random(rng);
     let w = params.phase.w;
     var mu: f32;
-    if u < w {
+    if is_table_phase() {
+        mu = table_sample_cos(u);
+    } else if u < w {
         mu = lobe_sample_cos(params.phase, min(u / w, ONE_MINUS_EPSILON), rng);
     } else {
         mu = lobe_sample_cos(params.phase_b, min((u - w) / (1.0 - w), ONE_MINUS_EPSILON), rng);

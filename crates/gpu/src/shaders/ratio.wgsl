@@ -35,13 +35,26 @@ fn tr_roulette(tr: f32, rng: ptr<function, u32>) -> f32 {
     return tr;
 }
 
-// Transmittance along render-space ray (origin, dir) to infinity.
-fn transmittance(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> f32 {
+// Transmittance per channel along render-space ray (origin, dir) to
+// infinity: a chromatic medium's by ratio tracking per channel, or a
+// track-length flight's spectral weights (spectral.wgsl,
+// track_length.rs); a grey one's the same in every channel.
+fn transmittance(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> vec3<f32> {
     let estimator = params.walk_mode.y;
     if estimator == TRANSMITTANCE_TRACK_LENGTH {
-        return select(0.0, 1.0, free_flight(origin, dir, rng).kind == FLIGHT_ESCAPED);
+        var weight = vec3<f32>(1.0);
+        let escaped = free_flight(origin, dir, &weight, rng).kind == FLIGHT_ESCAPED;
+        return select(vec3<f32>(0.0), weight, escaped);
     }
-    let residual = estimator == TRANSMITTANCE_RESIDUAL;
+    if chromatic() {
+        return ratio_tracking_rgb(origin, dir, rng);
+    }
+    return vec3<f32>(grey_transmittance(origin, dir, estimator == TRANSMITTANCE_RESIDUAL, rng));
+}
+
+// A grey medium's transmittance by (residual, where `residual`) ratio
+// tracking.
+fn grey_transmittance(origin: vec3<f32>, dir: vec3<f32>, residual: bool, rng: ptr<function, u32>) -> f32 {
     var w = walk_start(origin, dir, residual, rng);
     var tr = 1.0;
     loop {

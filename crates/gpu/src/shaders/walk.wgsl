@@ -22,8 +22,8 @@ const MAX_COLLISIONS: u32 = 1000000u;
 const EVENT_COLLISION: u32 = 0u;
 const EVENT_END: u32 = 1u;
 const EVENT_CAPPED: u32 = 2u;
-// The walk entered a segment (residual tracking applies its control
-// transmittance here).
+// The walk entered a segment with a minorant under residual tracking
+// (which applies its control transmittance here).
 const EVENT_ENTER: u32 = 3u;
 
 // Partition codes (partition.rs): an empty level-1 cell's flag; a cell
@@ -153,11 +153,13 @@ fn cell_code(c1: vec3<i32>) -> u32 {
 }
 
 // (min, max) of the eight voxels bounding voxel cell [c, c + 1)
-// (volume.rs, voxel_cell_range).
+// (volume.rs, voxel_cell_range), one voxel a turn of a loop the compiler
+// cannot unroll (common.wgsl, `corners`).
 fn voxel_cell_bounds(c: vec3<i32>) -> vec2<f32> {
     var lo = FAR;
     var hi = -FAR;
-    for (var k = 0; k < 8; k++) {
+    for (var k = 0; k < corners(); k++) {
+        iterations += 1u;
         let v = voxel(c + vec3<i32>((k >> 2u) & 1, (k >> 1u) & 1, k & 1));
         lo = min(lo, v);
         hi = max(hi, v);
@@ -237,7 +239,12 @@ fn walk_next(w: ptr<function, Walk>, rng: ptr<function, u32>) -> Event {
             (*w).rate = select((*w).seg_hi, (*w).seg_hi - (*w).seg_lo, (*w).residual);
             (*w).inside = true;
             (*w).t = (*w).seg_t0;
-            return Event(EVENT_ENTER, (*w).seg_t0);
+            // Only residual tracking has anything to do on entering a
+            // segment: the others walk on in this loop rather than
+            // another turn of the caller's, whose body is long.
+            if (*w).residual && (*w).seg_lo > 0.0 {
+                return Event(EVENT_ENTER, (*w).seg_t0);
+            }
         }
         let rate = (*w).rate;
         // `rate > 0` is false for NaN too: such segments are skipped.

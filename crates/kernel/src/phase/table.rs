@@ -112,6 +112,14 @@ impl TabulatedPhase {
         })
     }
 
+    /// The table as it is evaluated and sampled: the cosines (increasing,
+    /// from -1 to 1), the normalised values at them, the sampling CDF at
+    /// them and the density's scale over cosines (`2 pi / total`), for a
+    /// device that mirrors `eval_cos` and `sample_cos` (crates/gpu).
+    pub fn rows(&self) -> (&[f32], &[f32], &[f64], f64) {
+        (&self.mu, &self.value, &self.cdf, self.mu_density)
+    }
+
     /// Number of rows.
     pub fn len(&self) -> usize {
         self.mu.len()
