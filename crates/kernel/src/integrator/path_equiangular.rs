@@ -16,12 +16,20 @@
 //! null-collision estimators) and `sigma_s` by a lookup.
 //!
 //! The two strategies' weights are any pair summing to one at each `t`
-//! (Veach 1997's multi-sample model); the collision density needs the
-//! transmittance, which only a second walk could give, so the weights take
-//! the power heuristic of the equi-angular density against a uniform
-//! density over the segment's span: equi-angular sampling where it is
-//! denser (about the light), the collision elsewhere. Both are exact for
-//! any weights; these only decide the noise.
+//! (Veach 1997's multi-sample model), so each must be a deterministic
+//! function of the segment and `t` that both sites compute alike. They
+//! take the power heuristic of the equi-angular density against the free
+//! flight's collision density, `sigma_t(t) T(0, t)` ([`collision_density`]).
+//! That density needs `T(0, t)`, which in a heterogeneous medium the
+//! trackers only estimate (ratio tracking's estimate is random, and a
+//! random density in the power heuristic, drawn independently at the two
+//! sites, would no longer make the weights sum to one at each `t`: the
+//! estimate would be biased). So the weights take the transmittance between
+//! its two deterministic bounds, the majorant segments' `exp(-integral
+//! majorant)` and `exp(-integral minorant)`: their geometric mean, which
+//! is the exact transmittance in a homogeneous medium (minorant =
+//! majorant) and within those bounds elsewhere. Both strategies stay exact
+//! for any weights; these only decide the noise.
 //!
 //! One light per segment takes the equi-angular sample, picked in
 //! proportion to its unoccluded single scattering along the span,
@@ -108,11 +116,36 @@ impl EquiAngular {
 }
 
 /// The equi-angular strategy's weight at `t`, drawn with density `pdf`,
-/// on a span of length `len`: the power heuristic against a uniform density
-/// over the span (see the module documentation).
+/// against the free flight's collision density `flight` there (see the
+/// module documentation).
 #[inline]
-fn weight(pdf: f32, len: f32) -> f32 {
-    Strategies::drawn_with(pdf).or(1.0 / len).weight()
+fn weight(pdf: f32, flight: f32) -> f32 {
+    Strategies::drawn_with(pdf).or(flight).weight()
+}
+
+/// The free flight's collision density at `t` along `ray`, as the MIS
+/// weights take it: `sigma_t(t)` times the geometric mean of the majorant
+/// segments' bounds on `T(0, t)` (exact in a homogeneous medium; see the
+/// module documentation). Deterministic: the equi-angular sample and the
+/// collision's next-event estimate compute the same number.
+#[inline]
+pub(super) fn collision_density<M: Media>(medium: &M, ray: &Ray, t: f32) -> f32 {
+    let sigma: f32 = medium.extinction(ray.at(t), ray.time);
+    if !(sigma > 0.0) {
+        return 0.0;
+    }
+    let (mut least, mut most) = (0.0f32, 0.0f32);
+    for s in medium.majorants(ray.origin, ray.dir, 0.0, t) {
+        let len = (s.t1.min(t) - s.t0.max(0.0)).max(0.0);
+        least += s.minorant * len;
+        most += s.majorant * len;
+    }
+    let density = sigma * (-0.5 * (least + most)).exp();
+    if density.is_finite() {
+        density
+    } else {
+        0.0
+    }
 }
 
 /// A segment's span in the media, `[t0, t1]`, within `t_max`.
@@ -241,7 +274,7 @@ impl<M: Media> PathTracer<'_, M> {
             return 1.0;
         };
         let t = (v.p - ray.origin).dot(ray.dir);
-        1.0 - weight(ea.pdf(t), t1 - t0)
+        1.0 - weight(ea.pdf(t), collision_density(self.medium, ray, t))
     }
 
     /// The equi-angular sample of the path's current segment: one sphere
@@ -294,7 +327,7 @@ impl<M: Media> PathTracer<'_, M> {
             draws,
             c,
         );
-        let scale = weight(pdf, t1 - t0) / (q * pdf);
+        let scale = weight(pdf, collision_density(self.medium, &ray, t)) / (q * pdf);
         let e = path.beta * tr.rgb() * sigma_t.rgb() * it.albedo * it.weight * n * scale;
         path.add_to_group(e, self.lights.group(light), self.light_groups);
         if path.depth == 0 {
@@ -344,7 +377,7 @@ mod tests {
         let ray = Ray::new(Vec3::ZERO, Vec3::X);
         let ea = EquiAngular::new(&ray, Vec3::new(3.0, 0.5, 0.0), 0.0, 20.0).unwrap();
         for t in [0.1, 2.9, 3.0, 7.0, 19.0] {
-            let w = weight(ea.pdf(t), 20.0);
+            let w = weight(ea.pdf(t), 1.0 / 20.0);
             assert!((0.0..=1.0).contains(&w));
             if t == 3.0 {
                 assert!(w > 0.99, "about the light: {w}");
@@ -353,5 +386,24 @@ mod tests {
                 assert!(w < 0.5, "far from it: {w}");
             }
         }
+    }
+
+    /// In a homogeneous medium the collision density the weights take is
+    /// the free flight's own, `sigma exp(-sigma (t - t0))` from where the
+    /// ray enters; zero outside the medium.
+    #[test]
+    fn a_homogeneous_mediums_collision_density_is_exact() {
+        use crate::medium::{ConstantBox, Medium};
+        let sigma = 0.7;
+        let field = ConstantBox::new(Vec3::ZERO, Vec3::splat(10.0), 1.0, 1.0);
+        let medium = crate::volumes::Volumes::from(Medium::new(field, sigma, Vec3::splat(0.9), 0.0));
+        let ray = Ray::new(Vec3::new(-2.0, 5.0, 5.0), Vec3::X);
+        for t in [2.5f32, 4.0, 9.0, 11.9] {
+            let want = sigma * (-sigma * (t - 2.0)).exp();
+            let got = collision_density(&medium, &ray, t);
+            assert!((got / want - 1.0).abs() < 1e-5, "at {t}: {got} vs {want}");
+        }
+        assert_eq!(collision_density(&medium, &ray, 1.0), 0.0);
+        assert_eq!(collision_density(&medium, &ray, 12.5), 0.0);
     }
 }
