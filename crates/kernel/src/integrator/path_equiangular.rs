@@ -39,11 +39,13 @@
 
 use glam::Vec3;
 
+use super::light_choice::LightChoice;
 use super::light_tree::LightTree;
 use super::mis::Strategies;
 use super::path::PathTracer;
 use super::path_state::{Arrival, Path, Vertex};
 use super::per_light::MAX_PICKED_LIGHTS;
+use super::LightSampling;
 use crate::counters::Counters;
 use crate::light::{LightBounds, Lights};
 use crate::medium::Media;
@@ -131,7 +133,7 @@ fn weight(pdf: f32, flight: f32) -> f32 {
 #[inline]
 pub(super) fn collision_density<M: Media>(medium: &M, ray: &Ray, t: f32) -> f32 {
     let sigma: f32 = medium.extinction(ray.at(t), ray.time);
-    if !(sigma > 0.0) {
+    if sigma.is_nan() || sigma <= 0.0 {
         return 0.0;
     }
     let (mut least, mut most) = (0.0f32, 0.0f32);
@@ -237,10 +239,8 @@ impl PointPick {
                 Some((i, ea, 1.0 / points.len() as f32))
             }
             Self::Many(tree) => {
-                let reach = |b: &LightBounds| {
-                    let r = b.segment_importance(ray.origin, ray.dir, t0, t1);
-                    (r, r)
-                };
+                let reach =
+                    |b: &LightBounds| b.segment_importance_range(ray.origin, ray.dir, t0, t1);
                 let (i, q) = tree.pick(reach, u)?;
                 let ea = EquiAngular::new(ray, lights.get(i).point_centre()?, t0, t1)?;
                 Some((i, ea, q))
@@ -249,7 +249,56 @@ impl PointPick {
     }
 }
 
+impl PointPick {
+    /// The probability that [`Self::pick`] picks light `i` for `ray`'s
+    /// span `[t0, t1]` (0 for a light it does not hold).
+    #[inline]
+    fn probability(&self, ray: &Ray, t0: f32, t1: f32, i: usize) -> f32 {
+        match self {
+            Self::Few(points) => {
+                let reach = |&(_, c, l): &(usize, Vec3, f32)| {
+                    let w = l * EquiAngular::new(ray, c, t0, t1)?.reach();
+                    (w > 0.0 && w.is_finite()).then_some(w)
+                };
+                let total: f32 = points.iter().filter_map(reach).sum();
+                let own = points.iter().find(|p| p.0 == i).and_then(reach);
+                match own {
+                    Some(w) if total > 0.0 && total.is_finite() => w / total,
+                    _ => 0.0,
+                }
+            }
+            Self::Uniform(points) => {
+                // The indices are in ascending order.
+                if points.binary_search(&i).is_ok() {
+                    1.0 / points.len() as f32
+                } else {
+                    0.0
+                }
+            }
+            Self::Many(tree) => {
+                let reach =
+                    |b: &LightBounds| b.segment_importance_range(ray.origin, ray.dir, t0, t1);
+                tree.probability(reach, i)
+            }
+        }
+    }
+}
+
 impl<M: Media> PathTracer<'_, M> {
+    /// The probability that a vertex at `p` whose light choice is weighed
+    /// ([`LightChoice::Weighed`]: many lights, no shadow grid deciding)
+    /// samples light `i`, and 1 where vertices choose otherwise: the
+    /// factor the MIS weights give the collision's next-event estimate,
+    /// the same at both sites (see [`Self::collision_weight`]).
+    #[inline]
+    fn weighed_share(&self, p: Vec3, i: usize) -> f32 {
+        let weighed = self.shadows.is_none() || self.sampler.sampling() != LightSampling::One;
+        if !weighed {
+            return 1.0;
+        }
+        self.sampler.weighed_probability(p, i).unwrap_or(1.0)
+    }
+
     /// Whether a segment flown at `path.depth` takes an equi-angular sample:
     /// where a collision on it would estimate the lights (not past the
     /// last scattering event, not when only emission is gathered).
@@ -258,11 +307,17 @@ impl<M: Media> PathTracer<'_, M> {
         self.equiangular && !path.emission_only && self.max_depth.is_none_or(|m| path.depth < m)
     }
 
-    /// The weight of the next-event estimate of sphere light `light` at
-    /// vertex `v` against the equi-angular sample of the segment that
-    /// reached it: one minus the equi-angular strategy's weight there.
+    /// The weight of the next-event estimate of point-like light `i`,
+    /// centred at `centre` and sampled with probability `pick`, at vertex
+    /// `v` against the equi-angular sample of the segment that reached it:
+    /// one minus the equi-angular strategy's weight there. Each strategy's
+    /// density of gathering light `i` at `t` carries its pick: the
+    /// segment's pick of `i` times the equi-angular density, against the
+    /// vertex's pick of `i` times the collision density (where vertices
+    /// weigh many lights; 1 otherwise, as [`Self::weighed_share`]), so a
+    /// light the segment seldom aims at is left to the collisions near it.
     #[inline]
-    pub(super) fn collision_weight(&self, v: &Vertex, centre: Vec3) -> f32 {
+    pub(super) fn collision_weight(&self, v: &Vertex, i: usize, centre: Vec3, pick: f32) -> f32 {
         if !self.equiangular {
             return 1.0;
         }
@@ -274,7 +329,17 @@ impl<M: Media> PathTracer<'_, M> {
             return 1.0;
         };
         let t = (v.p - ray.origin).dot(ray.dir);
-        1.0 - weight(ea.pdf(t), collision_density(self.medium, ray, t))
+        let q = self.point_pick.probability(ray, t0, t1, i);
+        // The vertex's pick where it weighs many lights: the same number
+        // `weighed_share` gives the equi-angular sample at this point.
+        let share = match v.choice {
+            LightChoice::Weighed { .. } => pick,
+            _ => 1.0,
+        };
+        1.0 - weight(
+            q * ea.pdf(t),
+            share * collision_density(self.medium, ray, t),
+        )
     }
 
     /// The equi-angular sample of the path's current segment: one sphere
@@ -316,7 +381,7 @@ impl<M: Media> PathTracer<'_, M> {
             phase: it.phase,
             mis: self.max_depth != Some(depth),
             index: u32::MAX,
-            choice: super::light_choice::LightChoice::All,
+            choice: LightChoice::All,
             arrival: Arrival::default(),
         };
         let n = self.sample_light::<S>(
@@ -327,7 +392,8 @@ impl<M: Media> PathTracer<'_, M> {
             draws,
             c,
         );
-        let scale = weight(pdf, collision_density(self.medium, &ray, t)) / (q * pdf);
+        let flight = self.weighed_share(p, light) * collision_density(self.medium, &ray, t);
+        let scale = weight(q * pdf, flight) / (q * pdf);
         let e = path.beta * tr.rgb() * sigma_t.rgb() * it.albedo * it.weight * n * scale;
         path.add_to_group(e, self.lights.group(light), self.light_groups);
         if path.depth == 0 {
@@ -396,7 +462,8 @@ mod tests {
         use crate::medium::{ConstantBox, Medium};
         let sigma = 0.7;
         let field = ConstantBox::new(Vec3::ZERO, Vec3::splat(10.0), 1.0, 1.0);
-        let medium = crate::volumes::Volumes::from(Medium::new(field, sigma, Vec3::splat(0.9), 0.0));
+        let medium =
+            crate::volumes::Volumes::from(Medium::new(field, sigma, Vec3::splat(0.9), 0.0));
         let ray = Ray::new(Vec3::new(-2.0, 5.0, 5.0), Vec3::X);
         for t in [2.5f32, 4.0, 9.0, 11.9] {
             let want = sigma * (-sigma * (t - 2.0)).exp();
