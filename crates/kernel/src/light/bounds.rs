@@ -21,6 +21,9 @@ use super::{AreaLight, AreaShape};
 /// at a point light weighs finitely.
 const MIN_DISTANCE2: f32 = 1e-12;
 
+/// How far past a spot's cone, in radians, its bounds still see it.
+const SPOT_MARGIN: f32 = 0.01;
+
 /// The bounds of one light or of a cluster.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightBounds {
@@ -44,6 +47,23 @@ impl LightBounds {
             axis: Vec3::Z,
             cos_theta_o: -1.0,
             cos_theta_e: 0.0,
+        }
+    }
+
+    /// The same light sending nothing past the cone of cosine
+    /// `cos_outer` about unit `axis` (a spot): the least angle between the
+    /// cone and a point is taken from the box's whole extent, and a small
+    /// margin past the cone's edge (`SPOT_MARGIN`) keeps a point the spot
+    /// barely reaches from being starved by rounding.
+    pub fn within_cone(self, axis: Vec3, cos_outer: f32) -> Self {
+        if cos_outer <= -1.0 {
+            return self;
+        }
+        Self {
+            axis,
+            cos_theta_o: cos_outer,
+            cos_theta_e: SPOT_MARGIN.cos(),
+            ..self
         }
     }
 
@@ -334,6 +354,23 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A spot's bounds see it in its cone and a little past, and not
+    /// behind it.
+    #[test]
+    fn a_spots_bounds_are_its_cone() {
+        let c = Vec3::new(1.0, 2.0, 3.0);
+        let spot = LightBounds::ball(c, 0.0, 5.0).within_cone(Vec3::NEG_Y, 0.5f32.cos());
+        let at = |angle: f32| c + 10.0 * Vec3::new(angle.sin(), -angle.cos(), 0.0);
+        assert!((spot.importance(at(0.3)) - 0.05).abs() < 1e-6);
+        assert!(spot.importance(at(0.5 - 1e-4)) > 0.0);
+        assert_eq!(spot.importance(at(0.52)), 0.0);
+        assert_eq!(spot.importance(at(2.0)), 0.0);
+        assert_eq!(spot.importance_range(at(3.0)), (0.0, 0.0));
+        // Clustered with a ball, the spot's side still counts.
+        let both = spot.union(&LightBounds::ball(Vec3::ZERO, 0.0, 1.0));
+        assert!(both.importance(at(3.0)) > 0.0);
     }
 
     /// The polynomial span angle is the difference of the two arctangents
