@@ -19,6 +19,11 @@ pick (the light tree) against the uniform pick at equal time; with
 pick) beside them, the two builds run alternately.
 
     python3 tools/many_lights.py [CIRRUS] --embers [--baseline CIRRUS] [--spp N] [--ref-spp N]
+        [--seeds N] [--distance auto|equiangular]
+
+The embers' error is printed two ways: against the reference, and by the
+spread of the `--seeds` images (each strategy is unbiased, so its MSE is
+its variance; no reference noise enters it).
 
 Needs numpy and OpenEXR (`pip install numpy OpenEXR`).
 """
