@@ -19,6 +19,11 @@ pick (the light tree) against the uniform pick at equal time; with
 pick) beside them, the two builds run alternately.
 
     python3 tools/many_lights.py [CIRRUS] --embers [--baseline CIRRUS] [--spp N] [--ref-spp N]
+        [--seeds N] [--distance auto|equiangular]
+
+The embers' error is printed two ways: against the reference, and by the
+spread of the `--seeds` images (each strategy is unbiased, so its MSE is
+its variance; no reference noise enters it).
 
 Needs numpy and OpenEXR (`pip install numpy OpenEXR`).
 """
@@ -129,27 +134,41 @@ def ember_benchmark(a: argparse.Namespace) -> None:
         t10, t10k = per_sample[(label, 10)], per_sample[(label, 10000)]
         print(f"{label:10s} time per sample: 10 lights {t10 * 1e9:7.1f} ns, 10,000 lights "
               f"{t10k * 1e9:7.1f} ns: {t10k / t10:5.2f}x")
-    # Error at equal time, 10,000 lights: the weighed pick (this build's
-    # reference) against the uniform pick.
+    # Error at equal time, 10,000 lights: the weighed pick (the light
+    # tree) against the uniform pick, two ways. Against a reference (this
+    # build's weighed pick at --ref-spp): the reference's own noise adds
+    # to both strategies' error and, where the estimator's variance is
+    # heavy-tailed (points in a medium), its fireflies dominate both and
+    # pull the ratio toward one. And by the spread over seeds: each
+    # estimator is unbiased, so its mean squared error is its variance,
+    # estimated per pixel from --seeds independent images (no reference
+    # noise in it); both are normalised by the reference's mean.
     ref, _ = render_rgb(a.cirrus, ember_scene(10000, a.ref_spp, "auto", 1000, a.distance), d, "ref")
     mean = float(ref.mean())
+    seeds = range(1, a.seeds + 1)
     for label, exe in builds:
         rows = {}
         for sampling in ("uniform", "auto"):
-            errs, times = [], []
-            for seed in (1, 2, 3):
+            imgs, times = [], []
+            for seed in seeds:
                 img, t = render_rgb(exe, ember_scene(10000, a.spp, sampling, seed, a.distance), d, f"e{sampling}")
-                errs.append(np.mean((img - ref) ** 2))
+                imgs.append(img)
                 times.append(t)
-            rows[sampling] = (float(np.mean(errs)), float(np.mean(times)))
-        (mse_u, t_u), (mse_w, t_w) = rows["uniform"], rows["auto"]
+            stack = np.stack(imgs)
+            mse = float(np.mean((stack - ref) ** 2))
+            var = float(np.mean(stack.var(axis=0, ddof=1)))
+            rows[sampling] = (mse, var, float(np.mean(times)), float(stack.mean()))
+        (mse_u, var_u, t_u, _), (mse_w, var_w, t_w, _) = rows["uniform"], rows["auto"]
         # At equal time the MSE scales as 1 / time.
         ratio = (mse_u * t_u) / (mse_w * t_w)
-        for sampling, (mse, t) in rows.items():
+        ratio_var = (var_u * t_u) / (var_w * t_w)
+        for sampling, (mse, var, t, m) in rows.items():
             print(f"{label:10s} 10,000 lights {sampling:8s} time {t:6.2f} s  relative RMSE "
-                  f"{math.sqrt(mse) / mean:7.4f}")
+                  f"{math.sqrt(mse) / mean:7.4f} (vs reference), {math.sqrt(var) / mean:7.4f} "
+                  f"(seed spread); image mean / reference mean {m / mean:6.3f}")
         print(f"{label:10s} at equal time the weighed pick's MSE is {ratio:6.1f}x lower than "
-              f"the uniform pick's (RMSE {math.sqrt(ratio):5.2f}x)")
+              f"the uniform pick's (RMSE {math.sqrt(ratio):5.2f}x) against the reference, "
+              f"{ratio_var:6.1f}x (RMSE {math.sqrt(ratio_var):5.2f}x) by the seed spread")
 
 
 def main() -> None:
@@ -160,6 +179,8 @@ def main() -> None:
     ap.add_argument("--lights", default="1,10,100")
     ap.add_argument("--embers", action="store_true", help="the light tree's benchmark")
     ap.add_argument("--baseline", help="another build, measured beside (with --embers)")
+    ap.add_argument("--seeds", type=int, default=3,
+                    help="independent images per strategy (with --embers)")
     ap.add_argument("--distance", default="auto",
                     help="distance sampling of the embers' renders (auto, equiangular)")
     a = ap.parse_args()

@@ -199,6 +199,15 @@ impl LightSampler {
         }
     }
 
+    /// The probability that a vertex at `at` whose choice is weighed
+    /// ([`LightChoice::Weighed`]) samples light `i`; `None` where vertices
+    /// do not weigh many lights.
+    #[inline]
+    pub fn weighed_probability(&self, at: Vec3, i: usize) -> Option<f32> {
+        let many = self.many.as_ref()?;
+        Some(many.probability(at, many.total(at), i))
+    }
+
     /// The light a weighed pick at `at` samples with `u`, and its
     /// probability.
     #[inline]

@@ -337,10 +337,7 @@ mod tests {
         let members: Vec<usize> = (0..lights.len()).collect();
         let tree = LightTree::new(&lights, &members).unwrap();
         let (o, d) = (Vec3::new(-10.0, 50.0, 50.0), Vec3::X);
-        let imp = |b: &LightBounds| {
-            let s = b.segment_importance(o, d, 0.0, 120.0);
-            (s, s)
-        };
+        let imp = |b: &LightBounds| b.segment_importance_range(o, d, 0.0, 120.0);
         let pmf: Vec<f32> = (0..lights.len())
             .map(|i| tree.probability(imp, i))
             .collect();

@@ -16,12 +16,20 @@
 //! null-collision estimators) and `sigma_s` by a lookup.
 //!
 //! The two strategies' weights are any pair summing to one at each `t`
-//! (Veach 1997's multi-sample model); the collision density needs the
-//! transmittance, which only a second walk could give, so the weights take
-//! the power heuristic of the equi-angular density against a uniform
-//! density over the segment's span: equi-angular sampling where it is
-//! denser (about the light), the collision elsewhere. Both are exact for
-//! any weights; these only decide the noise.
+//! (Veach 1997's multi-sample model), so each must be a deterministic
+//! function of the segment and `t` that both sites compute alike. They
+//! take the power heuristic of the equi-angular density against the free
+//! flight's collision density, `sigma_t(t) T(0, t)` ([`collision_density`]).
+//! That density needs `T(0, t)`, which in a heterogeneous medium the
+//! trackers only estimate (ratio tracking's estimate is random, and a
+//! random density in the power heuristic, drawn independently at the two
+//! sites, would no longer make the weights sum to one at each `t`: the
+//! estimate would be biased). So the weights take the transmittance between
+//! its two deterministic bounds, the majorant segments' `exp(-integral
+//! majorant)` and `exp(-integral minorant)`: their geometric mean, which
+//! is the exact transmittance in a homogeneous medium (minorant =
+//! majorant) and within those bounds elsewhere. Both strategies stay exact
+//! for any weights; these only decide the noise.
 //!
 //! One light per segment takes the equi-angular sample, picked in
 //! proportion to its unoccluded single scattering along the span,
@@ -31,11 +39,13 @@
 
 use glam::Vec3;
 
+use super::light_choice::LightChoice;
 use super::light_tree::LightTree;
 use super::mis::Strategies;
 use super::path::PathTracer;
 use super::path_state::{Arrival, Path, Vertex};
 use super::per_light::MAX_PICKED_LIGHTS;
+use super::LightSampling;
 use crate::counters::Counters;
 use crate::light::{LightBounds, Lights};
 use crate::medium::Media;
@@ -108,11 +118,36 @@ impl EquiAngular {
 }
 
 /// The equi-angular strategy's weight at `t`, drawn with density `pdf`,
-/// on a span of length `len`: the power heuristic against a uniform density
-/// over the span (see the module documentation).
+/// against the free flight's collision density `flight` there (see the
+/// module documentation).
 #[inline]
-fn weight(pdf: f32, len: f32) -> f32 {
-    Strategies::drawn_with(pdf).or(1.0 / len).weight()
+fn weight(pdf: f32, flight: f32) -> f32 {
+    Strategies::drawn_with(pdf).or(flight).weight()
+}
+
+/// The free flight's collision density at `t` along `ray`, as the MIS
+/// weights take it: `sigma_t(t)` times the geometric mean of the majorant
+/// segments' bounds on `T(0, t)` (exact in a homogeneous medium; see the
+/// module documentation). Deterministic: the equi-angular sample and the
+/// collision's next-event estimate compute the same number.
+#[inline]
+pub(super) fn collision_density<M: Media>(medium: &M, ray: &Ray, t: f32) -> f32 {
+    let sigma: f32 = medium.extinction(ray.at(t), ray.time);
+    if sigma.is_nan() || sigma <= 0.0 {
+        return 0.0;
+    }
+    let (mut least, mut most) = (0.0f32, 0.0f32);
+    for s in medium.majorants(ray.origin, ray.dir, 0.0, t) {
+        let len = (s.t1.min(t) - s.t0.max(0.0)).max(0.0);
+        least += s.minorant * len;
+        most += s.majorant * len;
+    }
+    let density = sigma * (-0.5 * (least + most)).exp();
+    if density.is_finite() {
+        density
+    } else {
+        0.0
+    }
 }
 
 /// A segment's span in the media, `[t0, t1]`, within `t_max`.
@@ -204,10 +239,8 @@ impl PointPick {
                 Some((i, ea, 1.0 / points.len() as f32))
             }
             Self::Many(tree) => {
-                let reach = |b: &LightBounds| {
-                    let r = b.segment_importance(ray.origin, ray.dir, t0, t1);
-                    (r, r)
-                };
+                let reach =
+                    |b: &LightBounds| b.segment_importance_range(ray.origin, ray.dir, t0, t1);
                 let (i, q) = tree.pick(reach, u)?;
                 let ea = EquiAngular::new(ray, lights.get(i).point_centre()?, t0, t1)?;
                 Some((i, ea, q))
@@ -216,7 +249,56 @@ impl PointPick {
     }
 }
 
+impl PointPick {
+    /// The probability that [`Self::pick`] picks light `i` for `ray`'s
+    /// span `[t0, t1]` (0 for a light it does not hold).
+    #[inline]
+    fn probability(&self, ray: &Ray, t0: f32, t1: f32, i: usize) -> f32 {
+        match self {
+            Self::Few(points) => {
+                let reach = |&(_, c, l): &(usize, Vec3, f32)| {
+                    let w = l * EquiAngular::new(ray, c, t0, t1)?.reach();
+                    (w > 0.0 && w.is_finite()).then_some(w)
+                };
+                let total: f32 = points.iter().filter_map(reach).sum();
+                let own = points.iter().find(|p| p.0 == i).and_then(reach);
+                match own {
+                    Some(w) if total > 0.0 && total.is_finite() => w / total,
+                    _ => 0.0,
+                }
+            }
+            Self::Uniform(points) => {
+                // The indices are in ascending order.
+                if points.binary_search(&i).is_ok() {
+                    1.0 / points.len() as f32
+                } else {
+                    0.0
+                }
+            }
+            Self::Many(tree) => {
+                let reach =
+                    |b: &LightBounds| b.segment_importance_range(ray.origin, ray.dir, t0, t1);
+                tree.probability(reach, i)
+            }
+        }
+    }
+}
+
 impl<M: Media> PathTracer<'_, M> {
+    /// The probability that a vertex at `p` whose light choice is weighed
+    /// ([`LightChoice::Weighed`]: many lights, no shadow grid deciding)
+    /// samples light `i`, and 1 where vertices choose otherwise: the
+    /// factor the MIS weights give the collision's next-event estimate,
+    /// the same at both sites (see [`Self::collision_weight`]).
+    #[inline]
+    fn weighed_share(&self, p: Vec3, i: usize) -> f32 {
+        let weighed = self.shadows.is_none() || self.sampler.sampling() != LightSampling::One;
+        if !weighed {
+            return 1.0;
+        }
+        self.sampler.weighed_probability(p, i).unwrap_or(1.0)
+    }
+
     /// Whether a segment flown at `path.depth` takes an equi-angular sample:
     /// where a collision on it would estimate the lights (not past the
     /// last scattering event, not when only emission is gathered).
@@ -225,11 +307,17 @@ impl<M: Media> PathTracer<'_, M> {
         self.equiangular && !path.emission_only && self.max_depth.is_none_or(|m| path.depth < m)
     }
 
-    /// The weight of the next-event estimate of sphere light `light` at
-    /// vertex `v` against the equi-angular sample of the segment that
-    /// reached it: one minus the equi-angular strategy's weight there.
+    /// The weight of the next-event estimate of point-like light `i`,
+    /// centred at `centre` and sampled with probability `pick`, at vertex
+    /// `v` against the equi-angular sample of the segment that reached it:
+    /// one minus the equi-angular strategy's weight there. Each strategy's
+    /// density of gathering light `i` at `t` carries its pick: the
+    /// segment's pick of `i` times the equi-angular density, against the
+    /// vertex's pick of `i` times the collision density (where vertices
+    /// weigh many lights; 1 otherwise, as [`Self::weighed_share`]), so a
+    /// light the segment seldom aims at is left to the collisions near it.
     #[inline]
-    pub(super) fn collision_weight(&self, v: &Vertex, centre: Vec3) -> f32 {
+    pub(super) fn collision_weight(&self, v: &Vertex, i: usize, centre: Vec3, pick: f32) -> f32 {
         if !self.equiangular {
             return 1.0;
         }
@@ -241,7 +329,17 @@ impl<M: Media> PathTracer<'_, M> {
             return 1.0;
         };
         let t = (v.p - ray.origin).dot(ray.dir);
-        1.0 - weight(ea.pdf(t), t1 - t0)
+        let q = self.point_pick.probability(ray, t0, t1, i);
+        // The vertex's pick where it weighs many lights: the same number
+        // `weighed_share` gives the equi-angular sample at this point.
+        let share = match v.choice {
+            LightChoice::Weighed { .. } => pick,
+            _ => 1.0,
+        };
+        1.0 - weight(
+            q * ea.pdf(t),
+            share * collision_density(self.medium, ray, t),
+        )
     }
 
     /// The equi-angular sample of the path's current segment: one sphere
@@ -283,7 +381,7 @@ impl<M: Media> PathTracer<'_, M> {
             phase: it.phase,
             mis: self.max_depth != Some(depth),
             index: u32::MAX,
-            choice: super::light_choice::LightChoice::All,
+            choice: LightChoice::All,
             arrival: Arrival::default(),
         };
         let n = self.sample_light::<S>(
@@ -294,7 +392,8 @@ impl<M: Media> PathTracer<'_, M> {
             draws,
             c,
         );
-        let scale = weight(pdf, t1 - t0) / (q * pdf);
+        let flight = self.weighed_share(p, light) * collision_density(self.medium, &ray, t);
+        let scale = weight(q * pdf, flight) / (q * pdf);
         let e = path.beta * tr.rgb() * sigma_t.rgb() * it.albedo * it.weight * n * scale;
         path.add_to_group(e, self.lights.group(light), self.light_groups);
         if path.depth == 0 {
@@ -344,7 +443,7 @@ mod tests {
         let ray = Ray::new(Vec3::ZERO, Vec3::X);
         let ea = EquiAngular::new(&ray, Vec3::new(3.0, 0.5, 0.0), 0.0, 20.0).unwrap();
         for t in [0.1, 2.9, 3.0, 7.0, 19.0] {
-            let w = weight(ea.pdf(t), 20.0);
+            let w = weight(ea.pdf(t), 1.0 / 20.0);
             assert!((0.0..=1.0).contains(&w));
             if t == 3.0 {
                 assert!(w > 0.99, "about the light: {w}");
@@ -353,5 +452,25 @@ mod tests {
                 assert!(w < 0.5, "far from it: {w}");
             }
         }
+    }
+
+    /// In a homogeneous medium the collision density the weights take is
+    /// the free flight's own, `sigma exp(-sigma (t - t0))` from where the
+    /// ray enters; zero outside the medium.
+    #[test]
+    fn a_homogeneous_mediums_collision_density_is_exact() {
+        use crate::medium::{ConstantBox, Medium};
+        let sigma = 0.7;
+        let field = ConstantBox::new(Vec3::ZERO, Vec3::splat(10.0), 1.0, 1.0);
+        let medium =
+            crate::volumes::Volumes::from(Medium::new(field, sigma, Vec3::splat(0.9), 0.0));
+        let ray = Ray::new(Vec3::new(-2.0, 5.0, 5.0), Vec3::X);
+        for t in [2.5f32, 4.0, 9.0, 11.9] {
+            let want = sigma * (-sigma * (t - 2.0)).exp();
+            let got = collision_density(&medium, &ray, t);
+            assert!((got / want - 1.0).abs() < 1e-5, "at {t}: {got} vs {want}");
+        }
+        assert_eq!(collision_density(&medium, &ray, 1.0), 0.0);
+        assert_eq!(collision_density(&medium, &ray, 12.5), 0.0);
     }
 }

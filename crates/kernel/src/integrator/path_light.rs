@@ -76,7 +76,7 @@ impl<M: Media> PathTracer<'_, M> {
     ) -> Vec3 {
         let light = self.lights.get(i);
         let weight = match light.point_centre() {
-            Some(centre) => self.collision_weight(v, centre),
+            Some(centre) => self.collision_weight(v, i, centre, pick),
             None if self.sunward_light == Some(i) => v.arrival.sun_weight(pick),
             None => 1.0,
         };

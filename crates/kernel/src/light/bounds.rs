@@ -21,6 +21,9 @@ use super::{AreaLight, AreaShape};
 /// at a point light weighs finitely.
 const MIN_DISTANCE2: f32 = 1e-12;
 
+/// How far past a spot's cone, in radians, its bounds still see it.
+const SPOT_MARGIN: f32 = 0.01;
+
 /// The bounds of one light or of a cluster.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightBounds {
@@ -44,6 +47,23 @@ impl LightBounds {
             axis: Vec3::Z,
             cos_theta_o: -1.0,
             cos_theta_e: 0.0,
+        }
+    }
+
+    /// The same light sending nothing past the cone of cosine
+    /// `cos_outer` about unit `axis` (a spot): the least angle between the
+    /// cone and a point is taken from the box's whole extent, and a small
+    /// margin past the cone's edge (`SPOT_MARGIN`) keeps a point the spot
+    /// barely reaches from being starved by rounding.
+    pub fn within_cone(self, axis: Vec3, cos_outer: f32) -> Self {
+        if cos_outer <= -1.0 {
+            return self;
+        }
+        Self {
+            axis,
+            cos_theta_o: cos_outer,
+            cos_theta_e: SPOT_MARGIN.cos(),
+            ..self
         }
     }
 
@@ -182,6 +202,66 @@ impl LightBounds {
         let span = ((t1 - delta) / h).atan() - ((t0 - delta) / h).atan();
         self.phi * span.max(0.0) / h
     }
+
+    /// The cluster's least and greatest importance for the ray segment
+    /// from `o` along unit `dir` over `[t0, t1]`, over where in its ball
+    /// its light may come from: `phi integral dt / d^2` with the cluster
+    /// as a point at the distance of the ball's far side from the line and
+    /// of its near side (floored, as at a point: a segment through the
+    /// ball may pass as near as it likes to one of its lights). For one
+    /// point light both are its exact reach. The segment's counterpart of
+    /// [`Self::importance_range`], so that a segment passing by a small
+    /// cluster finds it however bright a large cluster beside it is.
+    #[inline]
+    pub fn segment_importance_range(&self, o: Vec3, dir: Vec3, t0: f32, t1: f32) -> (f32, f32) {
+        if self.phi <= 0.0 || t1 <= t0 {
+            return (0.0, 0.0);
+        }
+        let to_c = self.centre() - o;
+        let delta = to_c.dot(dir);
+        let h = (to_c - delta * dir).length();
+        let r = self.radius();
+        let reach = |h: f32| {
+            let h = h.max(MIN_DISTANCE2.sqrt());
+            self.phi * span_angle(h, t0 - delta, t1 - delta) / h
+        };
+        (reach(h + r), reach(h - r))
+    }
+}
+
+/// The angle `atan(b / h) - atan(a / h)` that the segment `[a, b]` of a
+/// line (`a <= b`) spans seen from a point at distance `h > 0` from it,
+/// its foot at 0: one `atan2` of the difference's tangent, by a
+/// polynomial (within about 1e-5 radians: the tree's importances need
+/// only be the same at the pick and at its probability, not exact, and
+/// this runs at every node a segment's pick visits).
+#[inline]
+fn span_angle(h: f32, a: f32, b: f32) -> f32 {
+    // tan(x - y) = (tan x - tan y) / (1 + tan x tan y), times h^2.
+    let (y, x) = (h * (b - a), h * h + a * b);
+    let (ay, ax) = (y.abs(), x.abs());
+    let (lo, hi) = (ay.min(ax), ay.max(ax));
+    if hi.is_nan() || hi <= 0.0 {
+        return 0.0;
+    }
+    let z = lo / hi;
+    let z2 = z * z;
+    let mut r = z
+        * (0.999_977_26
+            + z2 * (-0.332_623_47
+                + z2 * (0.193_543_46
+                    + z2 * (-0.116_432_87 + z2 * (0.052_653_32 + z2 * -0.011_721_2)))));
+    if ay > ax {
+        r = std::f32::consts::FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = PI - r;
+    }
+    if y < 0.0 {
+        0.0
+    } else {
+        r
+    }
 }
 
 /// `cos(max(0, a - b))` from the sines and cosines of `a` and `b`.
@@ -265,7 +345,52 @@ mod tests {
                     );
                     let su = u.segment_importance(o, d, 0.0, 15.0);
                     assert!(su > 0.0 || (sa == 0.0 && sb == 0.0));
+                    // The range: least no more than greatest, and none
+                    // for the cluster only where none for its lights.
+                    let range = |b: &LightBounds| b.segment_importance_range(o, d, 0.0, 15.0);
+                    let (lu, mu) = range(&u);
+                    assert!(lu <= mu && lu > 0.0, "{a} {b} at {p}: {lu} {mu}");
+                    assert!(range(&lights[a]).0 > 0.0 && range(&lights[b]).0 > 0.0);
                 }
+            }
+        }
+    }
+
+    /// A spot's bounds see it in its cone and a little past, and not
+    /// behind it.
+    #[test]
+    fn a_spots_bounds_are_its_cone() {
+        let c = Vec3::new(1.0, 2.0, 3.0);
+        let spot = LightBounds::ball(c, 0.0, 5.0).within_cone(Vec3::NEG_Y, 0.5f32.cos());
+        let at = |angle: f32| c + 10.0 * Vec3::new(angle.sin(), -angle.cos(), 0.0);
+        assert!((spot.importance(at(0.3)) - 0.05).abs() < 1e-6);
+        assert!(spot.importance(at(0.5 - 1e-4)) > 0.0);
+        assert_eq!(spot.importance(at(0.52)), 0.0);
+        assert_eq!(spot.importance(at(2.0)), 0.0);
+        assert_eq!(spot.importance_range(at(3.0)), (0.0, 0.0));
+        // Clustered with a ball, the spot's side still counts.
+        let both = spot.union(&LightBounds::ball(Vec3::ZERO, 0.0, 1.0));
+        assert!(both.importance(at(3.0)) > 0.0);
+    }
+
+    /// The polynomial span angle is the difference of the two arctangents
+    /// to within 2e-5 radians, on either side of the foot and past it.
+    #[test]
+    fn the_span_angle_is_the_difference_of_the_arctangents() {
+        for h in [1e-6f32, 0.01, 0.3, 1.0, 7.0, 500.0] {
+            for (a, b) in [
+                (-3.0f32, 5.0),
+                (0.5, 9.0),
+                (-9.0, -0.1),
+                (-1e4, 1e4),
+                (2.0, 2.0),
+            ] {
+                let want = (b / h).atan() - (a / h).atan();
+                let got = span_angle(h, a, b);
+                assert!(
+                    (got - want).abs() < 2e-5,
+                    "h {h}, [{a}, {b}]: {got} vs {want}"
+                );
             }
         }
     }
@@ -278,5 +403,7 @@ mod tests {
         let got = b.segment_importance(Vec3::ZERO, Vec3::X, 0.0, 10.0);
         let want = 5.0 * ((7.0f32 / 2.0).atan() - (-3.0f32 / 2.0).atan()) / 2.0;
         assert!((got / want - 1.0).abs() < 1e-5, "{got} vs {want}");
+        let (least, most) = b.segment_importance_range(Vec3::ZERO, Vec3::X, 0.0, 10.0);
+        assert!((least / want - 1.0).abs() < 1e-5 && (most / want - 1.0).abs() < 1e-5);
     }
 }

@@ -222,11 +222,13 @@ impl Light {
     pub fn bounds(&self) -> Option<LightBounds> {
         match self {
             Self::Distant(_) | Self::Dome(_) => None,
-            Self::Sphere(s) => Some(LightBounds::ball(
-                s.position(),
-                s.radius(),
-                luminance(s.intensity()),
-            )),
+            Self::Sphere(s) => {
+                let ball = LightBounds::ball(s.position(), s.radius(), luminance(s.intensity()));
+                Some(match s.spot() {
+                    Some(spot) => ball.within_cone(spot.axis(), spot.cos_outer()),
+                    None => ball,
+                })
+            }
             Self::Area(a) => Some(LightBounds::area(a)),
         }
     }

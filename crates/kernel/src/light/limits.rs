@@ -117,7 +117,8 @@ impl AreaLight {
     fn check_limits(&self) -> Result<(), String> {
         check_extent("centre", self.centre())?;
         check_extent("size", Vec3::splat(self.area().sqrt()))?;
-        if !(self.area() > 0.0) {
+        // NaN is not positive either.
+        if self.area().is_nan() || self.area() <= 0.0 {
             return Err(format!("its area {:e} is not positive in f32", self.area()));
         }
         if !self.normal().is_finite() {

@@ -68,6 +68,11 @@ impl Spot {
         self.axis
     }
 
+    /// The cosine of the cone's half-angle, past which it sends nothing.
+    pub fn cos_outer(&self) -> f32 {
+        self.cos_outer
+    }
+
     /// The fraction of the intensity sent along `dir` (unit, from the light).
     #[inline]
     pub fn falloff(&self, dir: Vec3) -> f32 {
