@@ -14,7 +14,8 @@
 //!   x-major, level after level (`Params::levels` says where each starts).
 //! - `partition`: the cell partition the CPU's walk reads
 //!   (`crates/bricks/src/partition.rs`), its byte codes four to a word.
-//! - `lights`: tagged records, one a light at infinity.
+//! - `lights`: tagged records, one a light (suns, a constant sky, sphere,
+//!   point and spot lights; [`LightRecord`] says each kind's fields).
 //! - `Params`: the render-to-local transform, the camera's basis, the
 //!   medium (density scale, albedo, HG g), sizes, the window, the seed,
 //!   the walk's majorants and shadow rays' estimator.
@@ -27,6 +28,7 @@ use glam::Vec3;
 /// Light record tags (`shaders/lights.wgsl`).
 pub const LIGHT_SUN: u32 = 0;
 pub const LIGHT_SKY: u32 = 1;
+pub const LIGHT_SPHERE: u32 = 2;
 
 /// Means `max_depth` is unlimited.
 pub const UNLIMITED_DEPTH: u32 = u32::MAX;
@@ -91,17 +93,26 @@ pub struct WalkChoice {
     pub transmittance: TransmittanceEstimator,
 }
 
-/// One light at infinity.
+/// One light, the same five vec4 for every kind (`shaders/lights.wgsl`
+/// and `shaders/sphere_light.wgsl` read them).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct LightRecord {
-    /// x: [`LIGHT_SUN`] or [`LIGHT_SKY`].
+    /// x: [`LIGHT_SUN`], [`LIGHT_SKY`] or [`LIGHT_SPHERE`]; y: 1 where
+    /// camera rays see its surface; z: 1 for a sphere light's soft
+    /// falloff (the disc facing the lit point).
     pub tag: [u32; 4],
     /// Sun: direction from the light (xyz), `1 - cos` of its half angle (w).
+    /// Sphere: centre (xyz), radius (w, 0 for a point).
     pub dir: [f32; 4],
     /// Sun: irradiance (xyz), solid angle (w, 0 for a delta sun).
-    /// Sky: radiance (xyz).
+    /// Sky: radiance (xyz). Sphere: its surface's radiance `I / (pi
+    /// r^2)` (xyz), a point's intensity `I`.
     pub radiance: [f32; 4],
+    /// Sphere: the spot's axis (xyz) and the cosine of its outer angle
+    /// (w; -2 without a spot, so that nothing falls off), then the cosine
+    /// of its inner angle (`[1].x`).
+    pub shape: [[f32; 4]; 3],
 }
 
 /// The scene as arrays, ready to upload.
@@ -333,7 +344,7 @@ fn camera_params(camera: &Camera) -> Params {
     }
 }
 
-/// A light at infinity as a record (`None` for the others, refused before).
+/// A light as a record (`None` for the kinds refused before, `support.rs`).
 fn light_record(light: &Light) -> Option<LightRecord> {
     let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
     match light {
@@ -341,12 +352,36 @@ fn light_record(light: &Light) -> Option<LightRecord> {
             tag: [LIGHT_SUN, 0, 0, 0],
             dir: v4(sun.direction(), sun.one_minus_cos_half_angle()),
             radiance: v4(sun.irradiance(), sun.solid_angle()),
+            ..Default::default()
         }),
         Light::Dome(env) => Some(LightRecord {
             tag: [LIGHT_SKY, 0, 0, 0],
             dir: [0.0; 4],
             radiance: v4(env.radiance, 0.0),
+            ..Default::default()
         }),
+        Light::Sphere(s) => {
+            let radiance = if s.is_point() {
+                s.intensity()
+            } else {
+                s.radiance()
+            };
+            let (axis, (cos_outer, cos_inner)) = match s.spot() {
+                Some(spot) => (spot.axis(), spot.cosines()),
+                None => (Vec3::Z, (-2.0, -2.0)),
+            };
+            Some(LightRecord {
+                tag: [
+                    LIGHT_SPHERE,
+                    u32::from(s.camera_visible()),
+                    u32::from(s.soft_falloff()),
+                    0,
+                ],
+                dir: v4(s.position(), s.radius()),
+                radiance: v4(radiance, 0.0),
+                shape: [v4(axis, cos_outer), [cos_inner, 0.0, 0.0, 0.0], [0.0; 4]],
+            })
+        }
         _ => None,
     }
 }

@@ -12,7 +12,7 @@ use crate::flat::{FlatScene, Params};
 
 /// The kernel's stages, in the order they are joined (WGSL declarations
 /// may come in any order; this is the order to read them in).
-pub const STAGES: [(&str, &str); 8] = [
+pub const STAGES: [(&str, &str); 9] = [
     ("common.wgsl", include_str!("shaders/common.wgsl")),
     ("lookup.wgsl", include_str!("shaders/lookup.wgsl")),
     ("walk.wgsl", include_str!("shaders/walk.wgsl")),
@@ -20,6 +20,10 @@ pub const STAGES: [(&str, &str); 8] = [
     ("ratio.wgsl", include_str!("shaders/ratio.wgsl")),
     ("phase.wgsl", include_str!("shaders/phase.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
+    (
+        "sphere_light.wgsl",
+        include_str!("shaders/sphere_light.wgsl"),
+    ),
     ("path.wgsl", include_str!("shaders/path.wgsl")),
 ];
 

@@ -23,7 +23,8 @@
 //! - `device.rs`: the adapter ([`open`]; the `device` setting that
 //!   chooses it is `cirrus_scene::Device`) and [`GpuError`].
 //! - `kernel.rs` and `shaders/`: the megakernel, one WGSL file a stage
-//!   (`lookup`, `walk`, `delta`, `ratio`, `lights`, `path`), each citing
+//!   (`lookup`, `walk`, `delta`, `ratio`, `phase`, `lights`,
+//!   `sphere_light`, `path`), each citing
 //!   the CPU code it mirrors; the scene uploaded once, one pass a sample
 //!   per pixel, each pixel's running moments kept on the device by the one
 //!   invocation that owns it.

@@ -88,7 +88,8 @@ impl RenderTarget {
         }
         match cirrus_gpu::render(gpu, &prepared.scene, &prepared.settings) {
             Ok(mut rendered) => {
-                if let Some(means) = cirrus_gpu::substitutions(&prepared.settings) {
+                if let Some(means) = cirrus_gpu::substitutions(&prepared.scene, &prepared.settings)
+                {
                     eprintln!("cirrus: the GPU estimates the same image with {means}");
                 }
                 let s = &mut rendered.stats;

@@ -38,10 +38,12 @@ struct Params {
     levels: array<vec4<u32>, 9>,
 }
 
+// Per kind: lights.wgsl.
 struct LightRecord {
     tag: vec4<u32>,
     dir: vec4<f32>,
     radiance: vec4<f32>,
+    shape: array<vec4<f32>, 3>,
 }
 
 // One pixel's running moments (Welford), as the host film keeps them,

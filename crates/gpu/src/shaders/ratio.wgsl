@@ -35,14 +35,20 @@ fn tr_roulette(tr: f32, rng: ptr<function, u32>) -> f32 {
     return tr;
 }
 
-// Transmittance along render-space ray (origin, dir) to infinity.
-fn transmittance(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> f32 {
+// Transmittance along render-space ray (origin, dir) up to `t_max`
+// (FAR: to infinity). A track-length flight whose collision lies past
+// `t_max` reached it (delta tracking is memoryless: the same odds as a
+// flight stopped there).
+fn transmittance(origin: vec3<f32>, dir: vec3<f32>, t_max: f32, rng: ptr<function, u32>) -> f32 {
     let estimator = params.walk_mode.y;
     if estimator == TRANSMITTANCE_TRACK_LENGTH {
-        return select(0.0, 1.0, free_flight(origin, dir, rng).kind == FLIGHT_ESCAPED);
+        let f = free_flight(origin, dir, rng);
+        let through = f.kind == FLIGHT_ESCAPED || (f.kind == FLIGHT_COLLISION && f.t >= t_max);
+        return select(0.0, 1.0, through);
     }
     let residual = estimator == TRANSMITTANCE_RESIDUAL;
     var w = walk_start(origin, dir, residual, rng);
+    w.t_end = min(w.t_end, t_max);
     var tr = 1.0;
     loop {
         iterations += 1u;
