@@ -56,7 +56,7 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
             Light::Dome(env) if env.map.is_none() => {}
             Light::Dome(_) => no("environment maps (a constant sky only)"),
             Light::Sphere(_) => {}
-            Light::Area(_) => no("area lights"),
+            Light::Area(_) => {}
         }
     }
     if scene.lights.over_shutter().is_some() {

@@ -104,12 +104,13 @@ fn substituted_estimators_are_said() {
     assert_eq!(substitutions(&settings), None);
 }
 
-/// Sphere, point and spot lights render (soft falloff too); lights that
+/// Sphere, point and spot lights (soft falloff too) and area lights
+/// (rects, discs, cylinders) render; lights that
 /// move while the shutter is open are refused by name; equi-angular
 /// sampling toward sphere lights, where the settings ask for it, is
 /// said as substituted.
 #[test]
-fn sphere_lights_render_and_moving_ones_are_refused() {
+fn local_lights_render_and_moving_ones_are_refused() {
     let lights = r#"
         [[volume]]
         file = "cloud.vdb"
@@ -128,6 +129,18 @@ fn sphere_lights_render_and_moving_ones_are_refused() {
         cone_softness = 0.4
         radius = 2
         soft_falloff = true
+        [[light]]
+        type = "rect"
+        position = [150, 160, 100]
+        direction = [0, -1, 0]
+        [[light]]
+        type = "disk"
+        position = [150, 160, 100]
+        direction = [0, -1, 0]
+        [[light]]
+        type = "cylinder"
+        position = [150, 160, 100]
+        direction = [1, 0, 0]
         "#;
     let names = refused(lights);
     assert!(names.is_empty(), "{names:?}");

@@ -4,18 +4,21 @@
 // sun, or a cone of uniform radiance irradiance / solid angle),
 // crates/kernel/src/light/dome.rs (a constant sky sampled uniformly) and
 // crates/kernel/src/sampling.rs (uniform_sphere, uniform_cone,
-// from_local, power_heuristic); sphere lights: sphere_light.wgsl.
+// from_local, power_heuristic); sphere lights: sphere_light.wgsl; area
+// lights: area_light.wgsl.
 //
 // Records (flat.rs, LightRecord; the same five vec4 for every kind):
 // tag.x the kind, then per kind
 // - sun: dir = direction from the light, 1 - cos of its half angle;
 //   radiance = irradiance, solid angle (0: a delta sun);
 // - sky: radiance = its radiance;
-// - sphere: sphere_light.wgsl.
+// - sphere: sphere_light.wgsl;
+// - area: area_light.wgsl.
 
 const LIGHT_SUN: u32 = 0u;
 const LIGHT_SKY: u32 = 1u;
 const LIGHT_SPHERE: u32 = 2u;
+const LIGHT_AREA: u32 = 3u;
 const UNIFORM_SPHERE_PDF: f32 = 0.0795774715459;
 
 // x s + y t for the tangents (s, t) of a frame whose z axis is `axis`
@@ -77,6 +80,9 @@ fn sample_light(i: u32, p: vec3<f32>, dir_in: vec3<f32>, mis: bool, rng: ptr<fun
     if l.tag.x == LIGHT_SPHERE {
         return sample_sphere_light(l, p, u1, u2);
     }
+    if l.tag.x == LIGHT_AREA {
+        return sample_area_light(l, p, u1, u2);
+    }
     if l.tag.x == LIGHT_SUN {
         let solid_angle = l.radiance.w;
         if solid_angle <= 0.0 {
@@ -97,7 +103,7 @@ fn sample_light(i: u32, p: vec3<f32>, dir_in: vec3<f32>, mis: bool, rng: ptr<fun
 // the sun's disc, or a light not at infinity).
 fn escaped_light(i: u32, dir: vec3<f32>) -> vec4<f32> {
     let l = lights[i];
-    if l.tag.x == LIGHT_SPHERE {
+    if l.tag.x == LIGHT_SPHERE || l.tag.x == LIGHT_AREA {
         return vec4<f32>(0.0);
     }
     if l.tag.x == LIGHT_SUN {
@@ -122,6 +128,9 @@ fn hit_light(i: u32, p: vec3<f32>, dir: vec3<f32>, t_max: f32, camera: bool) -> 
     }
     if l.tag.x == LIGHT_SPHERE {
         return hit_sphere_light(l, p, dir, t_max);
+    }
+    if l.tag.x == LIGHT_AREA {
+        return hit_area_light(l, p, dir, t_max);
     }
     return vec4<f32>(0.0);
 }
