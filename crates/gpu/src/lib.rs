@@ -12,7 +12,8 @@
 //!   or emitting media, motion, several volumes, AOVs and compositing
 //!   layers, adaptive sampling, denoising), and where it reaches the same
 //!   expectation by other estimators than the settings name
-//!   ([`substitutions`]: random numbers, every light at each vertex, no sunward
+//!   ([`substitutions`]: random numbers, every light at each vertex, no
+//!   equi-angular sampling toward sphere lights, no sunward
 //!   scattering).
 //! - `flat.rs`: the prepared scene `cirrus-scene` makes for every render
 //!   (the [`PreparedScene`]) as flat arrays ([`FlatScene`]): the brick
