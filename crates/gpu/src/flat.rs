@@ -14,7 +14,8 @@
 //!   x-major, level after level (`Params::levels` says where each starts).
 //! - `partition`: the cell partition the CPU's walk reads
 //!   (`crates/bricks/src/partition.rs`), its byte codes four to a word.
-//! - `lights`: tagged records, one a light at infinity.
+//! - `lights`: tagged records, one a light (suns, a constant sky, sphere,
+//!   point and spot lights; [`LightRecord`] says each kind's fields).
 //! - `phase_table`: a tabulated phase function's cosines, values and
 //!   sampling CDF (`crates/kernel/src/phase/table.rs`).
 //! - `Params`: the render-to-local transform, the camera's basis, the
@@ -23,12 +24,21 @@
 
 use bytemuck::{Pod, Zeroable};
 use cirrus_bricks::{Atlas, BrickVolume, CellPartition, MAX_LEVELS};
-use cirrus_render::{Camera, Light, MajorantMode, Medium, Phase, TransmittanceEstimator};
+use cirrus_render::{
+    AreaShape, Camera, Light, MajorantMode, Medium, Phase, TransmittanceEstimator,
+};
 use glam::Vec3;
 
 /// Light record tags (`shaders/lights.wgsl`).
 pub const LIGHT_SUN: u32 = 0;
 pub const LIGHT_SKY: u32 = 1;
+pub const LIGHT_SPHERE: u32 = 2;
+pub const LIGHT_AREA: u32 = 3;
+
+/// Area light shapes (`shaders/area_light.wgsl`).
+pub const AREA_RECT: u32 = 0;
+pub const AREA_DISK: u32 = 1;
+pub const AREA_CYLINDER: u32 = 2;
 
 /// Means `max_depth` is unlimited.
 pub const UNLIMITED_DEPTH: u32 = u32::MAX;
@@ -103,17 +113,30 @@ pub struct WalkChoice {
     pub transmittance: TransmittanceEstimator,
 }
 
-/// One light at infinity.
+/// One light, the same five vec4 for every kind (`shaders/lights.wgsl`
+/// and `shaders/sphere_light.wgsl` read them).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct LightRecord {
-    /// x: [`LIGHT_SUN`] or [`LIGHT_SKY`].
+    /// x: [`LIGHT_SUN`], [`LIGHT_SKY`], [`LIGHT_SPHERE`] or
+    /// [`LIGHT_AREA`]; y: 1 where camera rays see its surface; z: 1 for a
+    /// sphere light's soft falloff (the disc facing the lit point), an
+    /// area light's shape (`AREA_*`).
     pub tag: [u32; 4],
     /// Sun: direction from the light (xyz), `1 - cos` of its half angle (w).
+    /// Sphere: centre (xyz), radius (w, 0 for a point). Area: centre
+    /// (xyz), area (w).
     pub dir: [f32; 4],
     /// Sun: irradiance (xyz), solid angle (w, 0 for a delta sun).
-    /// Sky: radiance (xyz).
+    /// Sky: radiance (xyz). Sphere: its surface's radiance `I / (pi
+    /// r^2)` (xyz), a point's intensity `I`. Area: radiance (xyz).
     pub radiance: [f32; 4],
+    /// Sphere: the spot's axis (xyz) and the cosine of its outer angle
+    /// (w; -2 without a spot, so that nothing falls off), then the cosine
+    /// of its inner angle (`[1].x`). Area: its half axes u and v (a
+    /// cylinder's: half its length along the axis, its radius across),
+    /// its unit normal (a cylinder's axis).
+    pub shape: [[f32; 4]; 3],
 }
 
 /// The scene as arrays, ready to upload.
@@ -174,7 +197,7 @@ impl FlatScene {
             _ => 0,
         };
         let (atlas, precision) = atlas_words(volume.atlas());
-        let lights: Vec<LightRecord> = lights.iter().filter_map(light_record).collect();
+        let lights: Vec<LightRecord> = lights.iter().map(light_record).collect();
         let extent = volume.local_extent();
         let params = Params {
             local_from_render: local_matrix(local_ray),
@@ -391,20 +414,58 @@ fn camera_params(camera: &Camera) -> Params {
     }
 }
 
-/// A light at infinity as a record (`None` for the others, refused before).
-fn light_record(light: &Light) -> Option<LightRecord> {
+/// A light as a record (a dome's map, refused before by `support.rs`,
+/// would be its constant radiance).
+fn light_record(light: &Light) -> LightRecord {
     let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
     match light {
-        Light::Distant(sun) => Some(LightRecord {
+        Light::Distant(sun) => LightRecord {
             tag: [LIGHT_SUN, 0, 0, 0],
             dir: v4(sun.direction(), sun.one_minus_cos_half_angle()),
             radiance: v4(sun.irradiance(), sun.solid_angle()),
-        }),
-        Light::Dome(env) => Some(LightRecord {
+            ..Default::default()
+        },
+        Light::Dome(env) => LightRecord {
             tag: [LIGHT_SKY, 0, 0, 0],
             dir: [0.0; 4],
             radiance: v4(env.radiance, 0.0),
-        }),
-        _ => None,
+            ..Default::default()
+        },
+        Light::Sphere(s) => {
+            let radiance = if s.is_point() {
+                s.intensity()
+            } else {
+                s.radiance()
+            };
+            let (axis, (cos_outer, cos_inner)) = match s.spot() {
+                Some(spot) => (spot.axis(), spot.cosines()),
+                None => (Vec3::Z, (-2.0, -2.0)),
+            };
+            LightRecord {
+                tag: [
+                    LIGHT_SPHERE,
+                    u32::from(s.camera_visible()),
+                    u32::from(s.soft_falloff()),
+                    0,
+                ],
+                dir: v4(s.position(), s.radius()),
+                radiance: v4(radiance, 0.0),
+                shape: [v4(axis, cos_outer), [cos_inner, 0.0, 0.0, 0.0], [0.0; 4]],
+            }
+        }
+        Light::Area(a) => {
+            let (half_u, half_v) = a.half_axes();
+            let shape = match a.shape() {
+                AreaShape::Rect => AREA_RECT,
+                AreaShape::Disk => AREA_DISK,
+                AreaShape::Cylinder => AREA_CYLINDER,
+            };
+            LightRecord {
+                tag: [LIGHT_AREA, u32::from(a.camera_visible()), shape, 0],
+                dir: v4(a.centre(), a.area()),
+                radiance: v4(a.radiance(), 0.0),
+                shape: [v4(half_u, 0.0), v4(half_v, 0.0), v4(a.normal(), 0.0)],
+            }
+        }
     }
 }

@@ -13,7 +13,8 @@
 //!   motion, several volumes, AOVs and compositing
 //!   layers, adaptive sampling, denoising), and where it reaches the same
 //!   expectation by other estimators than the settings name
-//!   ([`substitutions`]: random numbers, every light at each vertex, no sunward
+//!   ([`substitutions`]: random numbers, every light at each vertex, no
+//!   equi-angular sampling toward sphere lights, no sunward
 //!   scattering).
 //! - `flat.rs`: the prepared scene `cirrus-scene` makes for every render
 //!   (the [`PreparedScene`]) as flat arrays ([`FlatScene`]): the brick
@@ -25,9 +26,9 @@
 //!   chooses it is `cirrus_scene::Device`) and [`GpuError`].
 //! - `kernel.rs` and `shaders/`: the megakernel, one WGSL file a stage
 //!   (`lookup`, `walk`, `spectral`, `delta`, `ratio`, `phase`,
-//!   `table_phase`, `lights`, `path`), each citing
-//!   the CPU code it mirrors; the scene uploaded once, each pixel's path
-//!   and running moments kept on the device by the one invocation that
+//!   `table_phase`, `lights`, `sphere_light`, `area_light`, `path`), each
+//!   citing the CPU code it mirrors; the scene uploaded once, each pixel's
+//!   path and running moments kept on the device by the one invocation that
 //!   owns it, a window whose paths exceed a binding rendered band by band.
 //! - [`render`] reads the moments back into the host's film
 //!   ([`cirrus_render::PassFilm`]), so the image resolves and writes

@@ -54,9 +54,12 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
             Light::Distant(_) => {}
             Light::Dome(env) if env.map.is_none() => {}
             Light::Dome(_) => no("environment maps (a constant sky only)"),
-            Light::Sphere(_) => no("sphere, point and spot lights"),
-            Light::Area(_) => no("area lights"),
+            Light::Sphere(_) => {}
+            Light::Area(_) => {}
         }
+    }
+    if scene.lights.over_shutter().is_some() {
+        no("lights moving while the shutter is open");
     }
     let instances = scene.media.instances();
     if instances.len() != 1 {
@@ -65,7 +68,20 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
             instances.len()
         ));
     }
+    // A chromatic medium's flight weights are not memoryless, so the
+    // kernel cannot stop a flight's weight at a light's surface or a
+    // shadow ray's track-length weight at a lamp: its lights are all at
+    // infinity.
+    let local_lights = scene
+        .lights
+        .clone()
+        .pruned()
+        .iter()
+        .any(|l| !l.is_at_infinity());
     for m in instances {
+        if local_lights && m.extinction_tint != glam::Vec3::ONE {
+            no("sphere, point, spot and area lights in chromatic media");
+        }
         if m.field.moves() || m.field.still_field().moves() {
             no("volume motion blur");
         }
@@ -84,11 +100,28 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
     out
 }
 
-/// Where the GPU estimates the same image by other means than `settings`
-/// name (each unbiased, so the expectation is the same; the noise is
-/// not), in words, for the caller to say; `None` where it uses those.
-pub fn substitutions(settings: &RenderSettings) -> Option<String> {
+/// Where the GPU estimates the same image of `scene` by other means than
+/// `settings` name (each unbiased, so the expectation is the same; the
+/// noise is not), in words, for the caller to say; `None` where it uses
+/// those.
+pub fn substitutions(scene: &PreparedScene, settings: &RenderSettings) -> Option<String> {
     let mut out = Vec::new();
+    // The CPU's rule (`PathTracer::with_distance_sampling`): equi-angular
+    // samples toward sphere, point and spot lights where the setting
+    // and the media say so.
+    let points = scene
+        .lights
+        .clone()
+        .pruned()
+        .iter()
+        .any(|l| l.point_centre().is_some());
+    if points && settings.distance_sampling.samples_equiangular(&scene.media) {
+        out.push(format!(
+            "free flights alone (no equi-angular sampling toward sphere lights) for \
+             --distance-sampling {}",
+            settings.distance_sampling.name()
+        ));
+    }
     if settings.sampler != SamplerKind::Random {
         out.push(format!(
             "random numbers for --sampler {}",

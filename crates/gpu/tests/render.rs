@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{block_mean, gpu, render_cpu, render_gpu, scene};
+use common::{agrees_with_cpu, bits, block_mean, gpu, render_gpu, scene};
 
 /// Albedo 1 under a uniform sky of radiance 1: every pixel's expectation
 /// is exactly 1, at any density, phase function or depth. A thick cloud
@@ -328,58 +328,6 @@ fn gpu_agrees_with_cpu_on_coarse_and_voxel_cells_by_track_length() {
     );
 }
 
-/// Renders the scene of `tables` (with a 16x16 camera at 64 spp) on both
-/// devices and compares 4x4-pixel blocks; the GPU render's statistics.
-fn agrees_with_cpu(tables: &str) -> cirrus_render::RenderStats {
-    let Some(gpu) = gpu() else {
-        return Default::default();
-    };
-    let s = scene(&format!(
-        r#"
-        [camera]
-        res = "16x16"
-        {tables}
-        "#
-    ));
-    let mut s = s;
-    s.apply(&cirrus_scene::Overrides {
-        spp: Some(64),
-        seed: Some(5),
-        ..Default::default()
-    });
-    let gr = render_gpu(&gpu, &s).expect("GPU render");
-    let c = render_cpu(&s).image;
-    let counted = &gr.stats.counters;
-    // Track-length shadow rays are free flights: no shadow collisions.
-    assert!(counted.real_collisions > 0);
-    assert!(counted.shadow_collisions > 0 || gr.stats.transmittance == "track-length");
-    assert_eq!(counted.paths, 16 * 16 * 64);
-    let stats = gr.stats;
-    let g = gr.image;
-    let mut worst: f64 = 0.0;
-    for by in 0..4 {
-        for bx in 0..4 {
-            let block = (4 * bx, 4 * by, 4 * bx + 4, 4 * by + 4);
-            for ch in 0..4 {
-                let (mg, sg) = block_mean(&g, ch, block);
-                let (mc, sc) = block_mean(&c, ch, block);
-                let se = (sg * sg + sc * sc).sqrt().max(1e-6);
-                let z = (mg - mc) / se;
-                worst = worst.max(z.abs());
-                assert!(
-                    z.abs() < 5.0,
-                    "block ({bx}, {by}) channel {ch}: GPU {mg} CPU {mc}, {z} standard errors"
-                );
-            }
-        }
-    }
-    // Not a trivially empty scene: the cloud lights up.
-    let (mean, _) = block_mean(&c, 1, (0, 0, 16, 16));
-    assert!(mean > 0.05, "CPU image mean {mean}");
-    eprintln!("largest block difference: {worst:.2} standard errors");
-    stats
-}
-
 /// Same seed, same settings, same device: the same bytes.
 #[test]
 fn same_seed_gives_the_same_image() {
@@ -400,16 +348,12 @@ fn same_seed_gives_the_same_image() {
     let a = render_gpu(&gpu, &scene(&text(9))).unwrap().image;
     let b = render_gpu(&gpu, &scene(&text(9))).unwrap().image;
     let c = render_gpu(&gpu, &scene(&text(10))).unwrap().image;
-    let bits = |i: &cirrus_render::Image| -> Vec<u32> {
-        i.rgba
-            .iter()
-            .chain(&i.variance)
-            .flatten()
-            .map(|v| v.to_bits())
-            .collect()
-    };
-    assert_eq!(bits(&a), bits(&b));
-    assert_ne!(bits(&a), bits(&c), "another seed gave the same image");
+    assert_eq!(bits(&a, true), bits(&b, true));
+    assert_ne!(
+        bits(&a, true),
+        bits(&c, true),
+        "another seed gave the same image"
+    );
 }
 
 /// A crop renders the same pixels as the whole image.
@@ -500,10 +444,7 @@ fn a_split_atlas_renders_the_same_bytes() {
         atlas_bytes > 2 * 4096,
         "a tiny atlas ({atlas_bytes} bytes) proves nothing"
     );
-    let bits = |i: &cirrus_render::Image| -> Vec<u32> {
-        i.rgba.iter().flatten().map(|v| v.to_bits()).collect()
-    };
-    assert_eq!(bits(&whole), bits(&split));
+    assert_eq!(bits(&whole, false), bits(&split, false));
 }
 
 /// A window whose paths exceed a binding is rendered band by band of

@@ -120,8 +120,8 @@ declare_settings! {
     /// one, else the CPU; a scene the GPU does not render goes to the CPU,
     /// saying why); gpu (any Vulkan adapter, lavapipe included; an error
     /// naming what the GPU does not render). The GPU renders the path
-    /// tracer over one volume lit by a sun and a constant sky (README, "On
-    /// a GPU").
+    /// tracer over one volume lit by suns, a constant sky, sphere, point,
+    /// spot and area lights (README, "On a GPU").
     device: Device, flag(long, value_enum), default(Device::Cpu), example(Device::Auto);
     /// Where light scatters along a ray: free flights and equi-angular
     /// sampling toward sphere, point and spot lights weighed by MIS (what

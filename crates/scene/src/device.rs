@@ -107,7 +107,8 @@ impl RenderTarget {
         }
         match cirrus_gpu::render(gpu, &prepared.scene, &prepared.settings) {
             Ok(mut rendered) => {
-                if let Some(means) = cirrus_gpu::substitutions(&prepared.settings) {
+                if let Some(means) = cirrus_gpu::substitutions(&prepared.scene, &prepared.settings)
+                {
                     if scene.warn_on_stderr {
                         eprintln!("cirrus: the GPU estimates the same image with {means}");
                     }

@@ -43,10 +43,12 @@ struct Params {
     tint: vec4<f32>,
 }
 
+// Per kind: lights.wgsl.
 struct LightRecord {
     tag: vec4<u32>,
     dir: vec4<f32>,
     radiance: vec4<f32>,
+    shape: array<vec4<f32>, 3>,
 }
 
 // One pixel's running moments (Welford), as the host film keeps them,

@@ -9,8 +9,9 @@
 //
 // Mirrors crates/kernel/src/integrator/path.rs (`trace`, `escape`,
 // `collide`, `scatter_from`, `roulette`) and path_light.rs (`direct_light`,
-// `light_term`) for one grey medium lit by lights at infinity (its phase
-// function: phase.wgsl): every
+// `light_term`) and path_flight.rs (light surfaces met on the way) for
+// one grey medium and its lights (lights.wgsl; phase function:
+// phase.wgsl): every
 // collision scatters with the albedo as weight, every light is sampled at
 // every vertex (shadow rays by the settings' estimator, ratio.wgsl), phase-sampled directions
 // that escape take the power heuristic against those samples, Russian
@@ -45,13 +46,32 @@ fn escape_radiance(dir: vec3<f32>, pdf: f32) -> vec3<f32> {
     return sum;
 }
 
+// What the light surfaces (balls) a ray from `origin` along `dir` meets
+// before `reach` add: lights do not block rays, and a flight reaches a
+// surface before its collision with the transmittance's odds, as the
+// CPU's flight split at each surface does (path_flight.rs, `fly`,
+// `gather_surface`). `pdf`: the density its direction was phase-sampled
+// with, weighed against each light's own sampling; a camera ray
+// (`camera`) sees the camera-visible ones whole.
+fn surface_radiance(origin: vec3<f32>, dir: vec3<f32>, reach: f32, pdf: f32, camera: bool) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < params.counts.x; i++) {
+        iterations += 1u;
+        let h = hit_light(i, origin, dir, reach, camera);
+        if h.w > 0.0 {
+            sum += h.xyz * select(power_heuristic(pdf, h.w), 1.0, camera);
+        }
+    }
+    return sum;
+}
+
 // Next-event estimation at `p`, reached along `dir_in`: one sample of
 // every light, weighed against phase sampling where `mis`.
 fn direct_light(p: vec3<f32>, dir_in: vec3<f32>, mis: bool, rng: ptr<function, u32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < params.counts.x; i++) {
         iterations += 1u;
-        let s = sample_light(i, dir_in, mis, rng);
+        let s = sample_light(i, p, dir_in, mis, rng);
         let f = phase_eval(dot(dir_in, s.to_light));
         var weight = 0.0;
         if s.pdf < 0.0 {
@@ -60,8 +80,9 @@ fn direct_light(p: vec3<f32>, dir_in: vec3<f32>, mis: bool, rng: ptr<function, u
             let w = select(1.0, power_heuristic(s.pdf, f), mis);
             weight = f * w / s.pdf;
         }
-        if weight > 0.0 {
-            sum += s.radiance * (weight * transmittance(p, s.to_light, rng));
+        // Outside a spot's cone: no light, no shadow ray.
+        if weight > 0.0 && max3(s.radiance) > 0.0 {
+            sum += s.radiance * (weight * transmittance(p, s.to_light, s.distance, rng));
         }
     }
     return sum;
@@ -102,6 +123,11 @@ fn advance(st: ptr<function, PathState>, rng: ptr<function, u32>) -> bool {
             alpha = select(0.0, 1.0 - (weighed.x + weighed.y + weighed.z) / 3.0, chromatic());
         }
         (*st).dir.w = alpha;
+    }
+    if flight.kind != FLIGHT_CAPPED {
+        let reach = select(flight.t, FAR, flight.kind == FLIGHT_ESCAPED);
+        let e = surface_radiance(origin, dir, reach, (*st).origin.w, (*st).depth == 0u);
+        (*st).radiance += vec4<f32>((*st).beta.xyz * e, 0.0);
     }
     if flight.kind == FLIGHT_ESCAPED {
         let e = escape_radiance(dir, (*st).origin.w);

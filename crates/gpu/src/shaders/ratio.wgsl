@@ -35,27 +35,34 @@ fn tr_roulette(tr: f32, rng: ptr<function, u32>) -> f32 {
     return tr;
 }
 
-// Transmittance per channel along render-space ray (origin, dir) to
-// infinity: a chromatic medium's by ratio tracking per channel, or a
-// track-length flight's spectral weights (spectral.wgsl,
-// track_length.rs); a grey one's the same in every channel.
-fn transmittance(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> vec3<f32> {
+// Transmittance per channel along render-space ray (origin, dir) up to
+// `t_max` (FAR: to infinity): a chromatic medium's by ratio tracking per
+// channel, or a track-length flight's spectral weights (spectral.wgsl,
+// track_length.rs); a grey one's the same in every channel. A grey
+// track-length flight whose collision lies past `t_max` reached it (delta
+// tracking is memoryless: the same odds as a flight stopped there); a
+// chromatic one's weights are not memoryless, and its lights are all at
+// infinity (`support.rs` refuses local lights in chromatic media).
+fn transmittance(origin: vec3<f32>, dir: vec3<f32>, t_max: f32, rng: ptr<function, u32>) -> vec3<f32> {
     let estimator = params.walk_mode.y;
     if estimator == TRANSMITTANCE_TRACK_LENGTH {
         var weight = vec3<f32>(1.0);
-        let escaped = free_flight(origin, dir, &weight, rng).kind == FLIGHT_ESCAPED;
-        return select(vec3<f32>(0.0), weight, escaped);
+        let f = free_flight(origin, dir, &weight, rng);
+        let through = f.kind == FLIGHT_ESCAPED
+            || (!chromatic() && f.kind == FLIGHT_COLLISION && f.t >= t_max);
+        return select(vec3<f32>(0.0), weight, through);
     }
     if chromatic() {
-        return ratio_tracking_rgb(origin, dir, rng);
+        return ratio_tracking_rgb(origin, dir, t_max, rng);
     }
-    return vec3<f32>(grey_transmittance(origin, dir, estimator == TRANSMITTANCE_RESIDUAL, rng));
+    return vec3<f32>(grey_transmittance(origin, dir, t_max, estimator == TRANSMITTANCE_RESIDUAL, rng));
 }
 
-// A grey medium's transmittance by (residual, where `residual`) ratio
+// A grey medium's transmittance up to `t_max` by (residual, where `residual`) ratio
 // tracking.
-fn grey_transmittance(origin: vec3<f32>, dir: vec3<f32>, residual: bool, rng: ptr<function, u32>) -> f32 {
+fn grey_transmittance(origin: vec3<f32>, dir: vec3<f32>, t_max: f32, residual: bool, rng: ptr<function, u32>) -> f32 {
     var w = walk_start(origin, dir, residual, rng);
+    w.t_end = min(w.t_end, t_max);
     var tr = 1.0;
     loop {
         iterations += 1u;

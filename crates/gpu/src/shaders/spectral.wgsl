@@ -60,8 +60,9 @@ fn tr_roulette_rgb(tr: vec3<f32>, rng: ptr<function, u32>) -> vec3<f32> {
 // Per-channel ratio tracking along render-space ray (origin, dir) to
 // infinity (tracking/ratio.rs over `Vec3`; residual tracking takes this
 // too for a chromatic medium, as tracking/mod.rs's `transmittance` does).
-fn ratio_tracking_rgb(origin: vec3<f32>, dir: vec3<f32>, rng: ptr<function, u32>) -> vec3<f32> {
+fn ratio_tracking_rgb(origin: vec3<f32>, dir: vec3<f32>, t_max: f32, rng: ptr<function, u32>) -> vec3<f32> {
     var w = walk_start(origin, dir, false, rng);
+    w.t_end = min(w.t_end, t_max);
     var tr = vec3<f32>(1.0);
     loop {
         iterations += 1u;

@@ -106,6 +106,13 @@ impl AreaLight {
         self.radiance
     }
 
+    /// Its half axes: a rect's or disc's (`u`, `v`), a cylinder's half
+    /// length along its axis and radius across (for backends that sample
+    /// it themselves).
+    pub fn half_axes(&self) -> (Vec3, Vec3) {
+        (self.half_u, self.half_v)
+    }
+
     pub fn area(&self) -> f32 {
         self.area
     }

@@ -73,6 +73,13 @@ impl Spot {
         self.cos_outer
     }
 
+    /// The cosines of its outer and inner angles, between which
+    /// [`Self::falloff`] blends (for backends that evaluate it
+    /// themselves).
+    pub fn cosines(&self) -> (f32, f32) {
+        (self.cos_outer, self.cos_inner)
+    }
+
     /// The fraction of the intensity sent along `dir` (unit, from the light).
     #[inline]
     pub fn falloff(&self, dir: Vec3) -> f32 {
