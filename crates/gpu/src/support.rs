@@ -49,13 +49,11 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
     if scene.camera.near() != 0.0 {
         no("near clipping");
     }
+    let mut local_lights = false;
     for light in scene.lights.clone().pruned().iter() {
-        match light {
-            Light::Distant(_) => {}
-            Light::Dome(env) if env.map.is_none() => {}
-            Light::Dome(_) => no("environment maps (a constant sky only)"),
-            Light::Sphere(_) => {}
-            Light::Area(_) => {}
+        local_lights |= !light.is_at_infinity();
+        if matches!(light, Light::Dome(env) if env.map.is_some()) {
+            no("environment maps (a constant sky only)");
         }
     }
     if scene.lights.over_shutter().is_some() {
@@ -72,12 +70,6 @@ pub fn unsupported(scene: &PreparedScene, settings: &RenderSettings) -> Vec<Stri
     // kernel cannot stop a flight's weight at a light's surface or a
     // shadow ray's track-length weight at a lamp: its lights are all at
     // infinity.
-    let local_lights = scene
-        .lights
-        .clone()
-        .pruned()
-        .iter()
-        .any(|l| !l.is_at_infinity());
     for m in instances {
         if local_lights && m.extinction_tint != glam::Vec3::ONE {
             no("sphere, point, spot and area lights in chromatic media");
