@@ -65,9 +65,13 @@ def lamps(n: int) -> list[dict]:
     return out
 
 
-def scene(n: int, spp: int, sampling: str, seed: int) -> str:
-    lights = "".join(
-        "[[light]]\n" + "".join(f"{k} = {json.dumps(v)}\n" for k, v in l.items()) for l in lamps(n)
+def lit_fog(lights: list[dict], spp: int, sampling: str, seed: int, render: str = "",
+            sky: str = "") -> str:
+    """The scene file of the cloud's fog lit by `lights` (dicts of
+    `[[light]]` keys), seen by the benchmark's camera; `render` and `sky`
+    are extra lines for `[render]` and the top level."""
+    tables = "".join(
+        "[[light]]\n" + "".join(f"{k} = {json.dumps(v)}\n" for k, v in l.items()) for l in lights
     )
     return f"""[camera]
 res = "160x100"
@@ -77,10 +81,13 @@ to = [150, 83, 100]
 spp = {spp}
 seed = {seed}
 light_sampling = "{sampling}"
-[environment]
-radiance = [0.002, 0.003, 0.005]
-{lights}
+{render}{sky}{tables}
 {CLOUD_FOG}"""
+
+
+def scene(n: int, spp: int, sampling: str, seed: int) -> str:
+    return lit_fog(lamps(n), spp, sampling, seed,
+                   sky="[environment]\nradiance = [0.002, 0.003, 0.005]\n")
 
 
 def embers(n: int) -> list[dict]:
@@ -101,20 +108,7 @@ def embers(n: int) -> list[dict]:
 
 
 def ember_scene(n: int, spp: int, sampling: str, seed: int, distance: str = "auto") -> str:
-    lights = "".join(
-        "[[light]]\n" + "".join(f"{k} = {json.dumps(v)}\n" for k, v in l.items()) for l in embers(n)
-    )
-    return f"""[camera]
-res = "160x100"
-from = [150, 83, -250]
-to = [150, 83, 100]
-[render]
-spp = {spp}
-seed = {seed}
-light_sampling = "{sampling}"
-distance_sampling = "{distance}"
-{lights}
-{CLOUD_FOG}"""
+    return lit_fog(embers(n), spp, sampling, seed, render=f'distance_sampling = "{distance}"\n')
 
 
 def ember_benchmark(a: argparse.Namespace) -> None:
