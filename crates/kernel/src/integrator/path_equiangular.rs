@@ -247,9 +247,7 @@ impl PointPick {
             }
         }
     }
-}
 
-impl PointPick {
     /// The probability that [`Self::pick`] picks light `i` for `ray`'s
     /// span `[t0, t1]` (0 for a light it does not hold).
     #[inline]
